@@ -1,0 +1,273 @@
+"""Deterministic clean-up of a spoken or typed task before it reaches the LLM.
+
+A 270M model copies numbers well but cannot do arithmetic, so everything the
+model would otherwise have to compute is done here: number words become
+digits, units become the profile's units (metres and radians), ASR homophones
+in numeric context become digits, and fillers go. Object words are kept.
+
+The output format is a contract with the adapter's training data, which is
+normalized by this same function: lowercase words separated by single
+spaces, clause commas written as ", ", numbers in canonical RSL spelling
+(at most 4 decimals), and every converted length or angle followed by `m`
+or `rad`. Improve coverage freely; do not change that format.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Sequence
+
+from rsl.plan import format_number
+
+_TOKEN = re.compile(r"\d*\.\d+|\d+|[a-z]+(?:'[a-z]+)?|°|,|[.!?;:]")
+
+_ONES = {
+    "zero": 0, "oh": 0, "one": 1, "two": 2, "three": 3, "four": 4, "five": 5, "six": 6, "seven": 7,
+    "eight": 8, "nine": 9, "ten": 10, "eleven": 11, "twelve": 12, "thirteen": 13, "fourteen": 14,
+    "fifteen": 15, "sixteen": 16, "seventeen": 17, "eighteen": 18, "nineteen": 19,
+}
+_TENS = {"twenty": 20, "thirty": 30, "forty": 40, "fifty": 50, "sixty": 60, "seventy": 70,
+         "eighty": 80, "ninety": 90}
+_DIGIT_WORDS = {**{w: v for w, v in _ONES.items() if v < 10}, "o": 0}
+_FRACTIONS = {"half": 0.5, "quarter": 0.25, "third": 1 / 3}
+
+# Words an ASR writes for a number word; only read as numbers when a unit or
+# `times` follows, so "go to the door" and "look for the cup" are untouched.
+_HOMOPHONES = {"to": 2, "too": 2, "for": 4, "fore": 4, "won": 1, "ate": 8, "tree": 3, "free": 3}
+
+_LENGTHS = {
+    **dict.fromkeys(("m", "meter", "meters", "metre", "metres", "mtr", "mtrs"), 1.0),
+    **dict.fromkeys(("cm", "centimeter", "centimeters", "centimetre", "centimetres", "cms"), 0.01),
+    **dict.fromkeys(("mm", "millimeter", "millimeters", "millimetre", "millimetres"), 0.001),
+    **dict.fromkeys(("ft", "foot", "feet"), 0.3048),
+    **dict.fromkeys(("inch", "inches"), 0.0254),
+    **dict.fromkeys(("yard", "yards", "yd"), 0.9144),
+    **dict.fromkeys(("km", "kilometer", "kilometers", "kilometre", "kilometres"), 1000.0),
+}
+_ANGLES = {
+    **dict.fromkeys(("degree", "degrees", "deg", "degs", "°"), math.pi / 180),
+    **dict.fromkeys(("rad", "rads", "radian", "radians"), 1.0),
+}
+# Whole turns: "two full turns", "3 circles". A bare "a turn" stays a verb.
+_REVOLUTIONS = {"turn", "turns", "circle", "circles", "rotation", "rotations", "revolution",
+                "revolutions", "spin", "spins", "lap", "laps"}
+
+_FILLERS: tuple[tuple[str, ...], ...] = tuple(
+    tuple(p.split())
+    for p in sorted(
+        [
+            "uh", "uhm", "uhh", "um", "umm", "erm", "er", "ah", "ahh", "hmm", "mm", "please", "kindly",
+            "could you", "can you", "would you", "will you", "could you please", "would you please",
+            "i want you to", "i need you to", "i'd like you to", "i would like you to", "you know",
+            "go ahead and", "hey robot", "ok robot", "okay robot", "okay", "ok", "alright", "just",
+            "for me", "thanks", "thank you", "robot could you", "i mean",
+        ],
+        key=lambda p: -len(p.split()),
+    )
+)
+
+
+def normalize_task(text: str) -> str:
+    """Normalize one task; see the module docstring for the output format."""
+    tokens = _tokenize(text)
+    tokens = _drop_fillers(tokens)
+    tokens = _convert_numbers(tokens)
+    return _render(tokens)
+
+
+def _tokenize(text: str) -> list[str]:
+    lowered = text.lower().replace("’", "'")
+    # "twenty-five", "x-axis": a hyphen between words is a space; a minus
+    # before a digit is kept as a word so coordinates stay signed.
+    lowered = re.sub(r"(?<=[a-z])-(?=[a-z])", " ", lowered)
+    lowered = re.sub(r"(?<![\w.])-(?=\.?\d)", " minus ", lowered)
+    tokens = []
+    for raw in _TOKEN.findall(lowered):
+        tokens.append("," if raw in ".!?;:" else raw)
+    return tokens
+
+
+def _drop_fillers(tokens: list[str]) -> list[str]:
+    out: list[str] = []
+    i = 0
+    while i < len(tokens):
+        for phrase in _FILLERS:
+            if tuple(tokens[i:i + len(phrase)]) == phrase:
+                i += len(phrase)
+                break
+        else:
+            out.append(tokens[i])
+            i += 1
+    return out
+
+
+def _is_number_token(token: str) -> bool:
+    return bool(re.fullmatch(r"\d*\.\d+|\d+", token))
+
+
+def _parse_integer_words(tokens: Sequence[str], i: int) -> tuple[float, int] | None:
+    """`twenty five`, `one hundred and twenty`, `seven`: value and next index."""
+    value = 0
+    last = ""  # the kind of the previous word: ones, tens, hundred, and
+    j = i
+    while j < len(tokens):
+        word = tokens[j]
+        if word in _ONES and word != "oh" and (
+                last in ("", "hundred", "and") or (last == "tens" and _ONES[word] < 10)):
+            value, last = value + _ONES[word], "ones"
+        elif word in _TENS and last in ("", "hundred", "and"):
+            value, last = value + _TENS[word], "tens"
+        elif word == "hundred" and last in ("ones", "tens") and value < 100:
+            value, last = value * 100, "hundred"
+        elif (word == "and" and last == "hundred" and j + 1 < len(tokens)
+              and (tokens[j + 1] in _ONES or tokens[j + 1] in _TENS)):
+            last = "and"
+        else:
+            break
+        j += 1
+    if last in ("", "and"):
+        return None
+    return float(value), j
+
+
+def _parse_number(tokens: Sequence[str], i: int) -> tuple[float, int] | None:
+    """A number starting at tokens[i], in digits or words, with its fractions."""
+    sign = 1.0
+    j = i
+    if j < len(tokens) and tokens[j] in ("minus", "negative") and j + 1 < len(tokens):
+        sign, j = -1.0, j + 1
+    value: float
+    if j < len(tokens) and _is_number_token(tokens[j]):
+        value, j = float(tokens[j]), j + 1
+    elif (parsed := _parse_integer_words(tokens, j)) is not None:
+        value, j = parsed
+    elif j < len(tokens) and tokens[j] == "point":
+        value = 0.0
+    else:
+        return None
+    if j + 1 < len(tokens) and tokens[j] == "point" and tokens[j + 1] in _DIGIT_WORDS:
+        digits = ""
+        j += 1
+        while j < len(tokens) and tokens[j] in _DIGIT_WORDS:
+            digits += str(_DIGIT_WORDS[tokens[j]])
+            j += 1
+        value += float("0." + digits)
+    if tokens[j:j + 3] in (["and", "a", "half"], ["and", "a", "quarter"]):
+        value += _FRACTIONS[tokens[j + 2]]
+        j += 3
+    return sign * value, j
+
+
+def _fraction_phrase(tokens: Sequence[str], i: int) -> tuple[float, int] | None:
+    """`half a`, `a half`, `a quarter of a`, `a`/`an` before a unit: value and next index."""
+    rest = tokens[i:i + 4]
+    for phrase, value in (
+        (["half", "of", "a"], 0.5), (["half", "a"], 0.5), (["half", "an"], 0.5),
+        (["a", "quarter", "of", "a"], 0.25), (["quarter", "of", "a"], 0.25), (["a", "quarter"], 0.25),
+        (["a", "half"], 0.5), (["half"], 0.5), (["quarter"], 0.25),
+        (["a", "couple", "of"], 2.0), (["a", "couple"], 2.0),
+        (["a"], 1.0), (["an"], 1.0), (["one"], 1.0),
+    ):
+        if rest[:len(phrase)] == phrase:
+            return value, i + len(phrase)
+    return None
+
+
+def _unit_at(tokens: Sequence[str], j: int) -> tuple[str, float, int] | None:
+    """A unit word at tokens[j]: (profile unit, factor, next index)."""
+    if j >= len(tokens):
+        return None
+    word = tokens[j]
+    if word in _LENGTHS:
+        return "m", _LENGTHS[word], j + 1
+    if word in _ANGLES:
+        return "rad", _ANGLES[word], j + 1
+    if word == "full" and j + 1 < len(tokens) and tokens[j + 1] in _REVOLUTIONS:
+        return "rad", 2 * math.pi, j + 2
+    return None
+
+
+def _revolutions_at(tokens: Sequence[str], j: int) -> int | None:
+    if j < len(tokens) and tokens[j] in _REVOLUTIONS and tokens[j].endswith("s"):
+        return j + 1
+    return None
+
+
+def _with_unit(tokens: Sequence[str], value: float, j: int, *, explicit: bool) -> tuple[str, int] | None:
+    """`value` followed by a unit at tokens[j], rendered as `N m` / `N rad`."""
+    unit = _unit_at(tokens, j)
+    if unit is None and explicit and (end := _revolutions_at(tokens, j)) is not None:
+        unit = ("rad", 2 * math.pi, end)
+    if unit is None:
+        return None
+    name, factor, end = unit
+    # "two meters and a half", "a meter and a half"
+    if tokens[end:end + 3] == ["and", "a", "half"]:
+        value, end = value + 0.5, end + 3
+    return f"{format_number(value * factor)} {name}", end
+
+
+def _convert_numbers(tokens: list[str]) -> list[str]:
+    out: list[str] = []
+    i = 0
+    while i < len(tokens):
+        token = tokens[i]
+        converted = _convert_at(tokens, i)
+        if converted is not None:
+            text, i = converted
+            out.append(text)
+            continue
+        if token in ("twice", "thrice"):
+            out.append("2 times" if token == "twice" else "3 times")
+        else:
+            out.append(token)
+        i += 1
+    return out
+
+
+def _convert_at(tokens: list[str], i: int) -> tuple[str, int] | None:
+    token = tokens[i]
+    parsed = _parse_number(tokens, i)
+    if parsed is not None:
+        value, j = parsed
+        if (unit := _with_unit(tokens, value, j, explicit=True)) is not None:
+            return unit
+        return format_number(value), j
+    if token in _HOMOPHONES:
+        nxt = tokens[i + 1] if i + 1 < len(tokens) else ""
+        if nxt == "times" or _unit_at(tokens, i + 1) is not None or _revolutions_at(tokens, i + 1):
+            value = float(_HOMOPHONES[token])
+            unit = _with_unit(tokens, value, i + 1, explicit=True)
+            return unit if unit is not None else (format_number(value), i + 1)
+        if tokens[i + 1:i + 4] == ["and", "a", "half"] and _unit_at(tokens, i + 4) is not None:
+            unit = _with_unit(tokens, _HOMOPHONES[token] + 0.5, i + 4, explicit=True)
+            if unit is not None:
+                return unit
+    fraction = _fraction_phrase(tokens, i)
+    if fraction is not None:
+        value, j = fraction
+        unit = _with_unit(tokens, value, j, explicit=False)
+        if unit is not None:
+            return unit
+        # "half a turn", "a quarter turn": fractions of a whole revolution.
+        if token in ("half", "quarter", "a") and value < 1 and j < len(tokens) and tokens[j] in (
+                "turn", "circle", "rotation", "revolution"):
+            return f"{format_number(value * 2 * math.pi)} rad", j + 1
+    return None
+
+
+def _render(tokens: list[str]) -> str:
+    words: list[str] = []
+    for token in tokens:
+        if token == ",":
+            if words and words[-1] != ",":
+                words.append(",")
+            continue
+        words.append(token)
+    while words and words[0] == ",":
+        words.pop(0)
+    while words and words[-1] == ",":
+        words.pop()
+    text = " ".join(words)
+    return text.replace(" ,", ",")

@@ -1,0 +1,53 @@
+"""The normalizer's output format is a contract with the adapter's training data."""
+
+import pytest
+
+from agent.normalize import normalize_task
+
+
+@pytest.mark.parametrize(
+    ("task", "expected"),
+    [
+        ("Move forward two meters, then grasp the cup.", "move forward 2 m, then grasp the cup"),
+        ("uh please turn left ninety degrees", "turn left 1.5708 rad"),
+        ("go forward to meters", "go forward 2 m"),
+        ("turn right for times", "turn right 4 times"),
+        ("move half a meter forward", "move 0.5 m forward"),
+        ("move back 50cm", "move back 0.5 m"),
+        ("drive two and a half meters", "drive 2.5 m"),
+        ("rotate 45°", "rotate 0.7854 rad"),
+        ("go to minus three point five, two", "go to -3.5, 2"),
+        ("go to 1, -2", "go to 1, -2"),
+        ("Could you go a meter and a half forward?", "go 1.5 m forward"),
+        ("spin two full turns", "spin 12.5664 rad"),
+        ("turn half a turn", "turn 3.1416 rad"),
+        ("move 3 feet", "move 0.9144 m"),
+        ("one hundred and twenty centimeters", "1.2 m"),
+        ("twenty-five degrees", "0.4363 rad"),
+        ("move forward 1.5m", "move forward 1.5 m"),
+        ("move forward one point five meters", "move forward 1.5 m"),
+        ("do it twice", "do it 2 times"),
+        ("Turn LEFT 3.14159 radians!", "turn left 3.1416 rad"),
+        ("move forward 300 millimetres", "move forward 0.3 m"),
+    ],
+)
+def test_normalize_converts_numbers_units_and_fillers(task: str, expected: str) -> None:
+    assert normalize_task(task) == expected
+
+
+@pytest.mark.parametrize(
+    "task",
+    ["look for the cup", "go to the door", "turn a little", "grasp the red cup", "make a turn"],
+)
+def test_normalize_keeps_words_that_only_sound_like_numbers(task: str) -> None:
+    assert normalize_task(task) == task
+
+
+def test_normalize_is_idempotent_on_its_own_output() -> None:
+    for task in ["move forward 2 m, then grasp the cup", "turn left 1.5708 rad", "go to -3.5, 2"]:
+        assert normalize_task(normalize_task(task)) == normalize_task(task)
+
+
+def test_normalize_of_empty_or_filler_only_text_is_empty() -> None:
+    assert normalize_task("") == ""
+    assert normalize_task("uh, um... please") == ""
