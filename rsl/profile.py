@@ -49,6 +49,9 @@ class Skill:
     example: str
     params: tuple[Param, ...]
     aliases: tuple[str, ...] = ()
+    # The skill that moves the same way in reverse, named in diagnostics when
+    # a negative value was written.
+    opposite: str | None = None
 
     @property
     def signature(self) -> str:
@@ -158,6 +161,8 @@ def _build(data: dict[str, Any], text: str, source: str) -> Profile:
             raise fail(f"skill `{skills[-1].keyword}` is declared twice")
         seen.add(skills[-1].keyword)
     for skill in skills:
+        if skill.opposite is not None and skill.opposite not in seen:
+            raise fail(f"skill `{skill.keyword}`: opposite `{skill.opposite}` is not a skill")
         for alias in skill.aliases:
             if alias in seen:
                 raise fail(f"alias `{alias}` of `{skill.keyword}` is itself a skill keyword")
@@ -227,4 +232,5 @@ def _skill(raw: dict[str, Any], index: int, workspace: dict[str, tuple[float, fl
                             max=None if high is None else float(high), axis=axis))
     aliases = tuple(str(a).lower() for a in raw.get("aliases", []))
     return Skill(keyword=word, description=str(raw.get("description", "")),
-                 example=str(raw.get("example", f"{word};")), params=tuple(params), aliases=aliases)
+                 example=str(raw.get("example", f"{word};")), params=tuple(params), aliases=aliases,
+                 opposite=raw.get("opposite"))
