@@ -141,12 +141,15 @@ class _Compiler:
         """Whether `token` must begin a new statement because a `;` is missing."""
         if token.kind not in _ARGUMENT_KINDS:
             return False
-        if token.line > statement.last.line and statement.last.kind is not Kind.COMMA:
+        is_command = token.kind is Kind.IDENT and self.profile.skill(token.text.lower()) is not None
+        if statement.skill is None:
+            return is_command
+        complete = len(statement.args) >= len(statement.skill.params)
+        if is_command and (complete or statement.expect_comma):
             return True
-        if token.kind is Kind.IDENT and self.profile.skill(token.text.lower()) is not None:
-            wanted = len(statement.skill.params) if statement.skill else 0
-            return statement.skill is None or len(statement.args) >= wanted or statement.expect_comma
-        return False
+        # Newlines are free inside a statement, so a line break only ends a
+        # statement that already has all its arguments.
+        return complete and token.line > statement.last.line and statement.last.kind is not Kind.COMMA
 
     def complete(self, statement: _Statement, terminated: bool = True) -> None:
         skill = statement.skill

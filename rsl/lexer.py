@@ -44,7 +44,9 @@ _PATTERNS: tuple[tuple[Kind, str], ...] = (
     (Kind.IDENT, r"[A-Za-z_]\w*"),
     (Kind.SEMI, r";"),
     (Kind.COMMA, r","),
-    (Kind.ILLEGAL, r"\S"),
+    # Anything else that is not C whitespace, including Unicode spaces and
+    # control characters, which would otherwise vanish without a word.
+    (Kind.ILLEGAL, r"[^ \t\r\n\f\v]"),
 )
 
 _GROUP = {f"k{i}": kind for i, (kind, _) in enumerate(_PATTERNS)}
@@ -60,6 +62,8 @@ _STATEMENT_RUN = rf"[A-Za-z_]\w*(?:[ \t]+{_ARG}(?:[ \t]*,[ \t]*{_ARG})*)?[ \t]*;
 # that bookkeeping cost more than the scan itself.
 _LEXEME = pp.Regex("|".join([_STATEMENT_RUN, *(f"(?:{pattern})" for _, pattern in _PATTERNS)]))
 _LEXEME.leave_whitespace()
+# Offsets must index the original text; pyparsing expands tabs unless told not to.
+_LEXEME.parse_with_tabs()
 
 
 @dataclass(frozen=True, slots=True)

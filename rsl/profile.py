@@ -214,7 +214,7 @@ def _skill(raw: dict[str, Any], index: int, workspace: dict[str, tuple[float, fl
     if not isinstance(word, str) or not SKILL_KEYWORD.match(word) or python_keyword.iskeyword(word):
         raise fail(f"skill #{index}: keyword {word!r} must be a lowercase identifier "
                    "([a-z][a-z0-9_]*) and not a Python keyword")
-    params = []
+    params: list[Param] = []
     for p in raw.get("params", []):
         kind = p.get("kind")
         if kind not in ("number", "object"):

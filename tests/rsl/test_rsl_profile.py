@@ -1,0 +1,71 @@
+"""The profile is the one source of truth: a new skill needs no code."""
+
+from __future__ import annotations
+
+import pytest
+
+from rsl.codegen import to_python
+from rsl.compiler import compile_program
+from rsl.describe import language_description, markdown_reference
+from rsl.grammar import to_gbnf
+from rsl.profile import ProfileError, default_profile_path, load_profile, parse_profile
+from tests.rsl import gbnf
+
+WAVE = """
+[[skills]]
+keyword = "wave"
+description = "Wave the gripper a number of times."
+example = "wave 3;"
+aliases = ["greet"]
+params = [{ name = "times", kind = "number", unit = "waves", min = 1, max = 5 }]
+"""
+
+
+@pytest.fixture(scope="module")
+def waving():
+    return parse_profile(default_profile_path().read_text() + WAVE, source="waving.toml")
+
+
+def test_default_profile_declares_the_twelve_skills(profile):
+    assert profile.keywords == ("forward", "backward", "turnleft", "turnright", "lookup", "lookdown",
+                                "lookleft", "lookright", "perceive", "approach", "grasp", "goto")
+    assert [len(s.params) for s in profile.skills] == [1] * 8 + [0, 1, 1, 2]
+
+
+def test_an_extra_skill_parses_compiles_and_appears_everywhere(waving, profile):
+    result = compile_program("forward 1;\nwave 3;\n", waving)
+    assert result.ok and result.plan.commands[1].skill == "wave"
+    assert result.plan.commands[1].number() == 3.0
+    assert not compile_program("wave 3;", profile).ok
+    assert [d.code.code for d in compile_program("wave 9;", waving).diagnostics] == ["E101"]
+    assert "did you mean `wave`" in compile_program("greet 2;", waving).diagnostics[0].message
+
+    grammar = to_gbnf(waving)
+    assert '"wave " number-1 ";"' in grammar
+    assert gbnf.parse(grammar).regex().fullmatch("wave 3;\n\n")
+    assert "`wave TIMES;` Wave the gripper" in language_description(waving)
+    assert "`wave TIMES;`" in markdown_reference(waving)
+    assert "robot.wave(3.0, cancel=cancel)" in to_python(result.plan)
+
+
+@pytest.mark.parametrize(("patch", "complaint"), [
+    ('keyword = "Forward"', "must be a lowercase identifier"),
+    ('keyword = "import"', "not a Python keyword"),
+    ('kind = "colour"', "must be \"number\" or \"object\""),
+])
+def test_broken_profiles_are_rejected_with_the_reason(patch, complaint):
+    text = default_profile_path().read_text()
+    key = patch.split(" = ")[0]
+    original = 'keyword = "forward"' if key == "keyword" else 'kind = "number"'
+    with pytest.raises(ProfileError, match=complaint):
+        parse_profile(text.replace(original, patch, 1), source="broken.toml")
+
+
+def test_missing_profile_file_is_a_clear_error(tmp_path):
+    with pytest.raises(ProfileError, match="cannot read robot profile"):
+        load_profile(tmp_path / "absent.toml")
+
+
+def test_not_toml_is_a_clear_error():
+    with pytest.raises(ProfileError, match="not valid TOML"):
+        parse_profile("[[skills]\n", source="bad.toml")
