@@ -1,0 +1,402 @@
+"""The daemon's settings: one TOML file, every setting with a default.
+
+The dataclasses below are the single source of truth: `load_config` reads
+them, `render_markdown` writes docs/config.md from them and `render_toml`
+writes a commented example file, so the documentation cannot drift from
+the code.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import tomllib
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+from typing import Any, get_type_hints
+
+
+class ConfigError(ValueError):
+    """A configuration that cannot be used; the message says where and what to do."""
+
+
+def _doc(text: str, **extra: Any) -> dict[str, Any]:
+    return {"doc": text, **extra}
+
+
+@dataclass(frozen=True)
+class ApiConfig:
+    socket: str = field(
+        default="",
+        metadata=_doc(
+            "Path of the Unix socket. Empty: `$RUNTIME_DIRECTORY/nrtrans.sock`, else "
+            "`$XDG_RUNTIME_DIR/nrtrans/nrtrans.sock`, else `/run/nrtrans/nrtrans.sock`."
+        ),
+    )
+    socket_mode: str = field(default="0660", metadata=_doc("Permission bits of the socket file, as an octal string."))
+    allowed_uids: tuple[int, ...] = field(
+        default=(),
+        metadata=_doc(
+            "Peer user ids that may connect (checked with SO_PEERCRED). Empty, together with an "
+            "empty `allowed_gids`: anyone who can open the socket file. The daemon's own uid is "
+            "always allowed."
+        ),
+    )
+    allowed_gids: tuple[int, ...] = field(
+        default=(), metadata=_doc("Peer primary group ids that may connect (checked with SO_PEERCRED).")
+    )
+    max_line_bytes: int = field(
+        default=65536,
+        metadata=_doc(
+            "Longest request frame, in bytes including the newline. A longer frame gets a "
+            "`too_long` error and is skipped; the connection stays usable.",
+            min=256,
+        ),
+    )
+    max_task_chars: int = field(
+        default=2000, metadata=_doc("Longest `text` task or `rsl` program a `submit` may carry, in characters.", min=1)
+    )
+    max_clients: int = field(
+        default=128,
+        metadata=_doc("Most connections served at once; the next one gets a `busy` error and is closed.", min=1),
+    )
+    client_queue: int = field(
+        default=1024,
+        metadata=_doc(
+            "Most frames waiting to be sent to one client. A client that falls this far behind "
+            "is disconnected, so a slow reader never holds up the others.",
+            min=8,
+        ),
+    )
+
+
+@dataclass(frozen=True)
+class TasksConfig:
+    queue_size: int = field(
+        default=8,
+        metadata=_doc(
+            "Most tasks waiting behind the one in progress. A `submit` beyond it gets a `busy` "
+            "error; nothing is dropped silently.",
+            min=1,
+        ),
+    )
+    history: int = field(default=200, metadata=_doc("Finished tasks kept in memory for `status`.", min=1))
+    shutdown_grace: float = field(
+        default=10.0,
+        metadata=_doc(
+            "Seconds SIGTERM waits for the task in progress to stop and its audit record to be "
+            "written, after the robot has been stopped.",
+            min=0.0,
+        ),
+    )
+
+
+@dataclass(frozen=True)
+class TranslatorConfig:
+    model: str = field(default="", metadata=_doc("GGUF model file. Empty: the embedded Gemma 3 270M model."))
+    adapter: str = field(default="", metadata=_doc("LoRA adapter file for the model. Empty: the translator's default."))
+    endpoint: str = field(
+        default="",
+        metadata=_doc(
+            "Use a translation server at this address instead of loading the model in-process. Empty: in-process."
+        ),
+    )
+    grammar: bool = field(
+        default=True, metadata=_doc("Limit sampling to the RSL grammar generated from the robot profile.")
+    )
+    max_passes: int = field(
+        default=3,
+        metadata=_doc("Most translation attempts per task (the first plus repairs from compiler diagnostics).", min=1),
+    )
+
+
+@dataclass(frozen=True)
+class RobotConfig:
+    profile: str = field(default="", metadata=_doc("Robot profile TOML. Empty: the built-in default profile."))
+    backend: str = field(
+        default="sim",
+        metadata=_doc("Where verified programs run: `sim` (pybullet, headless) or `ros2`.", choices=("sim", "ros2")),
+    )
+    scene: str = field(default="", metadata=_doc("Simulator scene. Empty: the simulator's default scene."))
+    realtime_factor: float = field(
+        default=1.0, metadata=_doc("Simulator speed: 1.0 runs in real time, 0 as fast as possible.", min=0.0)
+    )
+
+
+@dataclass(frozen=True)
+class AuditConfig:
+    file: str = field(default="audit.jsonl", metadata=_doc("Audit log file name, relative to the state directory."))
+    max_bytes: int = field(
+        default=10_000_000,
+        metadata=_doc(
+            "Size at which the audit log is rotated (`audit.jsonl.1`, ...), checked between "
+            "tasks so one task's record never spans two files.",
+            min=1024,
+        ),
+    )
+    keep: int = field(default=5, metadata=_doc("Rotated audit files kept.", min=0))
+
+
+@dataclass(frozen=True)
+class SpeechSection:
+    enabled: bool = field(
+        default=True,
+        metadata=_doc(
+            "Listen for spoken tasks. With no audio device or no model the daemon keeps serving "
+            "the socket API and `health` says why speech is off."
+        ),
+    )
+    options: dict[str, Any] = field(
+        default_factory=dict,
+        metadata=_doc(
+            "Settings handed to the speech input unchanged (device, Vosk model path, wake word, "
+            "...); see the speech section of the README."
+        ),
+    )
+
+
+@dataclass(frozen=True)
+class Config:
+    state_dir: str = field(
+        default="",
+        metadata=_doc("Where the audit log lives. Empty: `$STATE_DIRECTORY`, else `~/.local/state/nrtrans`."),
+    )
+    log_level: str = field(
+        default="info",
+        metadata=_doc(
+            "Log verbosity on stderr (the journal under systemd).", choices=("debug", "info", "warning", "error")
+        ),
+    )
+    api: ApiConfig = field(default_factory=ApiConfig, metadata=_doc("The local socket API."))
+    tasks: TasksConfig = field(default_factory=TasksConfig, metadata=_doc("The task queue."))
+    translator: TranslatorConfig = field(default_factory=TranslatorConfig, metadata=_doc("Turning a task into RSL."))
+    robot: RobotConfig = field(default_factory=RobotConfig, metadata=_doc("The robot and its backend."))
+    audit: AuditConfig = field(default_factory=AuditConfig, metadata=_doc("The audit log."))
+    speech: SpeechSection = field(default_factory=SpeechSection, metadata=_doc("Speech input."))
+
+    def socket_path(self) -> Path:
+        if self.api.socket:
+            return Path(self.api.socket).expanduser()
+        return runtime_dir() / "nrtrans.sock"
+
+    def state_path(self) -> Path:
+        if self.state_dir:
+            return Path(self.state_dir).expanduser()
+        if os.environ.get("STATE_DIRECTORY"):
+            # systemd may pass several directories separated by colons; ours is the first.
+            return Path(os.environ["STATE_DIRECTORY"].split(":")[0])
+        return Path.home() / ".local" / "state" / "nrtrans"
+
+    def audit_path(self) -> Path:
+        return self.state_path() / self.audit.file
+
+    def with_overrides(
+        self, *, socket: str | None = None, state_dir: str | None = None, backend: str | None = None
+    ) -> Config:
+        config = self
+        if socket:
+            config = dataclasses.replace(config, api=dataclasses.replace(config.api, socket=socket))
+        if state_dir:
+            config = dataclasses.replace(config, state_dir=state_dir)
+        if backend:
+            _check_choice("robot.backend", backend, _meta(RobotConfig, "backend"))
+            config = dataclasses.replace(config, robot=dataclasses.replace(config.robot, backend=backend))
+        return config
+
+
+def runtime_dir() -> Path:
+    if os.environ.get("RUNTIME_DIRECTORY"):
+        return Path(os.environ["RUNTIME_DIRECTORY"].split(":")[0])
+    if os.environ.get("XDG_RUNTIME_DIR"):
+        return Path(os.environ["XDG_RUNTIME_DIR"]) / "nrtrans"
+    return Path("/run/nrtrans")
+
+
+def default_socket_path() -> Path:
+    """Where clients look when no `--socket` is given: `$NRTRANS_SOCKET`, else the daemon's default."""
+    if os.environ.get("NRTRANS_SOCKET"):
+        return Path(os.environ["NRTRANS_SOCKET"])
+    return runtime_dir() / "nrtrans.sock"
+
+
+def config_path_from_env(flag: str | None) -> Path | None:
+    chosen = flag or os.environ.get("NRTRANS_CONFIG")
+    return Path(chosen).expanduser() if chosen else None
+
+
+def load_config(path: str | Path | None) -> Config:
+    """Read the config file; defaults everywhere when `path` is None."""
+    if path is None:
+        return Config()
+    config_file = Path(path)
+    try:
+        text = config_file.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ConfigError(
+            f"cannot read config file {config_file}: {exc.strerror}\n"
+            "  = help: pass an existing file with --config, or unset NRTRANS_CONFIG to use defaults"
+        ) from exc
+    return parse_config(text, source=str(config_file))
+
+
+def parse_config(text: str, source: str = "<config>") -> Config:
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{source}: not valid TOML: {exc}") from exc
+    config = _build(Config, data, source, prefix="")
+    assert isinstance(config, Config)
+    return config
+
+
+def _meta(cls: type, name: str) -> dict[str, Any]:
+    return dict(next(f for f in fields(cls) if f.name == name).metadata)
+
+
+def _check_choice(key: str, value: Any, meta: dict[str, Any]) -> None:
+    choices = meta.get("choices")
+    if choices and value not in choices:
+        raise ConfigError(f"{key} = {value!r} is not one of {', '.join(map(repr, choices))}")
+
+
+def _build(cls: type, data: Any, source: str, prefix: str) -> Any:
+    where = prefix.rstrip(".") or "the top level"
+    if not isinstance(data, dict):
+        raise ConfigError(f"{source}: {where} must be a table")
+    hints = get_type_hints(cls)
+    known = {f.name: f for f in fields(cls)}
+    unknown = sorted(set(data) - set(known))
+    if unknown:
+        raise ConfigError(
+            f"{source}: unknown setting {prefix}{unknown[0]}\n"
+            f"  = help: the settings here are {', '.join(prefix + k for k in known)}; see docs/config.md"
+        )
+    values: dict[str, Any] = {}
+    for name, value in data.items():
+        key = prefix + name
+        hint = hints[name]
+        if dataclasses.is_dataclass(hint):
+            values[name] = _build(hint, value, source, key + ".")  # type: ignore[arg-type]
+            continue
+        values[name] = _coerce(key, hint, value, known[name].metadata, source)
+    return cls(**values)
+
+
+def _coerce(key: str, hint: Any, value: Any, meta: Any, source: str) -> Any:
+    def wrong(expected: str) -> ConfigError:
+        return ConfigError(f"{source}: {key} must be {expected}, not {value!r}")
+
+    if hint is bool:
+        if not isinstance(value, bool):
+            raise wrong("true or false")
+        return value
+    if hint is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise wrong("a whole number")
+        result: Any = value
+    elif hint is float:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise wrong("a number")
+        result = float(value)
+    elif hint is str:
+        if not isinstance(value, str):
+            raise wrong("a string")
+        result = value
+    elif hint == tuple[int, ...]:
+        if not isinstance(value, list) or not all(isinstance(v, int) and not isinstance(v, bool) for v in value):
+            raise wrong("a list of whole numbers")
+        return tuple(value)
+    elif hint == dict[str, Any]:
+        if not isinstance(value, dict):
+            raise wrong("a table")
+        return dict(value)
+    else:
+        raise ConfigError(f"{source}: {key} has an unsupported type {hint}")
+    if "min" in meta and result < meta["min"]:
+        raise ConfigError(f"{source}: {key} = {value!r} is below the minimum {meta['min']}")
+    if key.endswith("socket_mode"):
+        try:
+            int(result, 8)
+        except ValueError:
+            raise wrong('an octal string like "0660"') from None
+    _check_choice(f"{source}: {key}", result, dict(meta))
+    return result
+
+
+def _rows(cls: type, prefix: str) -> list[tuple[str, str, Any, str]]:
+    rows = []
+    hints = get_type_hints(cls)
+    for f in fields(cls):
+        hint = hints[f.name]
+        if dataclasses.is_dataclass(hint):
+            continue
+        default = f.default_factory() if f.default is dataclasses.MISSING else f.default  # type: ignore[misc]
+        rows.append((prefix + f.name, _toml_value(default), hint, f.metadata["doc"]))
+    return rows
+
+
+def _sections() -> list[tuple[str, str, type]]:
+    hints = get_type_hints(Config)
+    return [
+        (f.name, f.metadata["doc"], hints[f.name]) for f in fields(Config) if dataclasses.is_dataclass(hints[f.name])
+    ]
+
+
+def _toml_value(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return f'"{value}"'
+    if isinstance(value, tuple):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "{}"
+    return repr(value)
+
+
+def render_markdown() -> str:
+    """docs/config.md, generated from the dataclasses above."""
+    lines = [
+        "# nrtrans daemon configuration",
+        "",
+        "<!-- Generated by `nrtrans serve --config-doc`; edit agent/daemon/config.py instead. -->",
+        "",
+        "`nrtrans serve` reads one TOML file: `--config FILE`, else `$NRTRANS_CONFIG`, else",
+        "built-in defaults. `--socket`, `--state-dir` and `--backend` override the file.",
+        "SIGHUP re-reads the file: the API limits, allow-lists, queue and audit settings",
+        "apply at once; the others (socket, state directory, model, profile, backend, speech)",
+        "are reported and take effect on the next start. An unknown or mistyped setting is",
+        "an error, never silently ignored. `nrtrans serve --print-config` prints a",
+        "commented file with every default.",
+        "",
+        "## Top level",
+        "",
+    ]
+    lines += _table(_rows(Config, ""))
+    for name, doc, cls in _sections():
+        lines += ["", f"## [{name}]", "", doc, ""]
+        lines += _table(_rows(cls, ""))
+    return "\n".join(lines) + "\n"
+
+
+def _table(rows: list[tuple[str, str, Any, str]]) -> list[str]:
+    out = ["| setting | default | meaning |", "|---|---|---|"]
+    for key, default, _hint, doc in rows:
+        out.append(f"| `{key}` | `{default}` | {doc} |")
+    return out
+
+
+def render_toml() -> str:
+    """A complete example config file with every default, commented."""
+    lines = ["# nrtrans daemon configuration; every value shown is the default.", ""]
+    for key, default, _hint, doc in _rows(Config, ""):
+        lines += [f"# {doc}", f"{key} = {default}", ""]
+    for name, doc, cls in _sections():
+        lines += [f"# {doc}", f"[{name}]"]
+        for key, default, _hint, field_doc in _rows(cls, ""):
+            if default == "{}":
+                lines += [f"# {field_doc}", f"[{name}.{key}]", ""]
+                continue
+            lines += [f"# {field_doc}", f"{key} = {default}"]
+        lines.append("")
+    return "\n".join(lines)

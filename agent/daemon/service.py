@@ -1,0 +1,540 @@
+"""The service: loads the profile, translator and robot, and runs tasks one at a time.
+
+Requests arrive from the socket server's event loop and only ever queue,
+cancel or inspect; the worker thread is the one place a program reaches the
+robot, and it does so only with a plan the compiler verified. Every change
+of a task goes to the audit log (fsync'd) before it is announced.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import threading
+import time
+from collections import OrderedDict
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from agent.daemon.audit import AuditError, AuditLog
+from agent.daemon.config import Config
+from agent.daemon.events import EventBus
+from agent.daemon.protocol import ProtocolError
+from agent.daemon.tasks import Busy, Peer, Task, TaskQueue, TaskState
+
+log = logging.getLogger(__name__)
+
+
+class StartupError(RuntimeError):
+    """A part the daemon cannot run without failed to load; the message says what to do."""
+
+
+class Service:
+    def __init__(self, config: Config, *, on_status: Callable[[str], None] = lambda _s: None) -> None:
+        self.config = config
+        self.events = EventBus()
+        self.queue = TaskQueue(config.tasks.queue_size)
+        self.audit = AuditLog(config.audit_path(), max_bytes=config.audit.max_bytes, keep=config.audit.keep)
+        self.on_status = on_status
+        self.profile: Any = None
+        self.translator: Any = None
+        self.robot: Any = None
+        self.speech: Any = None
+        self.speech_problem = "not started"
+        self.started = time.monotonic()
+        self._lock = threading.Lock()
+        self._tasks: OrderedDict[str, Task] = OrderedDict()
+        self._current: Task | None = None
+        self._estop_reason: str | None = None
+        self._stopping = False
+        self._worker: threading.Thread | None = None
+        self._worker_error: str | None = None
+
+    # -- start and stop -------------------------------------------------------------------------
+
+    def load(self) -> None:
+        """Load everything a task needs; raises `StartupError` with the reason and a fix."""
+        self.on_status("opening the audit log")
+        try:
+            for record in self.audit.open():
+                log.warning(
+                    "task %s was in flight when the daemon last stopped; marked interrupted and not run again",
+                    record["task"],
+                )
+        except AuditError as exc:
+            raise StartupError(str(exc.strerror)) from exc
+        self.on_status("loading the robot profile")
+        self.profile = _load_profile(self.config.robot.profile)
+        self.on_status("loading the translation model")
+        self.translator = _load_translator(self.config, self.profile)
+        self.on_status(f"opening the {self.config.robot.backend} backend")
+        self.robot = _open_robot(self.config, self.profile)
+        if self.config.speech.enabled:
+            self.on_status("starting speech input")
+            self._start_speech()
+        else:
+            self.speech_problem = "disabled in the config ([speech] enabled = false)"
+        self._worker = threading.Thread(target=self._work, name="nrtrans-worker", daemon=True)
+        self._worker.start()
+
+    def shutdown(self, reason: str = "the daemon is shutting down") -> None:
+        """Stop the robot first, then let the task in progress end and record it."""
+        with self._lock:
+            self._stopping = True
+            current = self._current
+        if current is not None:
+            current.cancel.set(reason)
+        self._stop_robot()
+        self.queue.close()
+        for task in self.queue.drain():
+            self._finish(task, TaskState.CANCELLED, reason)
+        if self._worker is not None:
+            self._worker.join(self.config.tasks.shutdown_grace)
+            if self._worker.is_alive() and current is not None:
+                # Still inside a translation that cannot be interrupted; nothing has moved.
+                self._finish(current, TaskState.CANCELLED, reason)
+        if self.speech is not None:
+            _quietly(self.speech.stop)
+        if self.robot is not None:
+            _quietly(self.robot.close)
+        self.audit.close()
+
+    def alive(self) -> bool:
+        return self._worker is not None and self._worker.is_alive() and self._worker_error is None
+
+    def apply_config(self, new: Config) -> list[str]:
+        """Take over the settings that can change while running; returns those that cannot."""
+        needs_restart = [
+            name
+            for name, old, changed in (
+                ("state_dir", self.config.state_path(), new.state_path()),
+                ("api.socket", self.config.socket_path(), new.socket_path()),
+                ("translator", self.config.translator, new.translator),
+                ("robot", self.config.robot, new.robot),
+                ("speech", self.config.speech, new.speech),
+                ("audit.file", self.config.audit.file, new.audit.file),
+            )
+            if old != changed
+        ]
+        self.queue.capacity = new.tasks.queue_size
+        self.audit.max_bytes = new.audit.max_bytes
+        self.audit.keep = new.audit.keep
+        self.config = new
+        return needs_restart
+
+    # -- requests ---------------------------------------------------------------------------
+
+    def submit(
+        self,
+        *,
+        source: str,
+        text: str | None = None,
+        rsl: str | None = None,
+        peer: Peer | None = None,
+        before_queue: Callable[[Task], None] | None = None,
+    ) -> tuple[Task, int]:
+        task = Task(source=source, text=text, rsl=rsl, peer=peer)
+        with self._lock:
+            if self._stopping:
+                raise ProtocolError(
+                    "shutting_down", "the daemon is shutting down", "submit again once it has restarted"
+                )
+            if self._estop_reason is not None:
+                raise ProtocolError(
+                    "estopped",
+                    f"an emergency stop is latched ({self._estop_reason})",
+                    "check that the robot is safe, then send `reset` (`nrtrans reset`)",
+                )
+            if before_queue is not None:
+                before_queue(task)
+            try:
+                position = self.queue.put(task)
+            except Busy as exc:
+                raise ProtocolError(
+                    "busy",
+                    f"the task queue is full: {exc}",
+                    "wait for a task to finish (`nrtrans events`) and submit again",
+                ) from exc
+            self._remember(task)
+        # Written before the reply, so an accepted task is never missing from the log.
+        self.audit.write(task.record())
+        self.events.publish("queued", task.id, source=source, position=position, text=text, rsl=rsl)
+        return task, position
+
+    def task(self, task_id: str) -> Task:
+        with self._lock:
+            task = self._tasks.get(task_id)
+        if task is None:
+            raise ProtocolError(
+                "not_found",
+                f"no task {task_id!r} is known to this daemon",
+                "`nrtrans history` lists the recent tasks, including ones before a restart",
+            )
+        return task
+
+    def cancel(self, task_id: str) -> Task:
+        task = self.task(task_id)
+        if self.queue.remove(task_id) is not None:
+            self._finish(task, TaskState.CANCELLED, "cancelled by request before it started")
+        elif not task.state.finished:
+            task.cancel.set("cancelled by request")
+        return task
+
+    def estop(self, reason: str) -> None:
+        """Stop the robot before anything else, then latch and cancel all work."""
+        self._stop_robot()
+        with self._lock:
+            self._estop_reason = reason
+            current = self._current
+        if current is not None:
+            current.cancel.set(f"emergency stop: {reason}")
+        for task in self.queue.drain():
+            self._finish(task, TaskState.CANCELLED, f"emergency stop: {reason}")
+        self.events.publish("estop", None, reason=reason)
+        self.on_status(f"EMERGENCY STOP latched: {reason}; send reset to resume")
+
+    def reset(self) -> bool:
+        with self._lock:
+            was_latched = self._estop_reason is not None
+            self._estop_reason = None
+        if was_latched:
+            self.events.publish("reset", None)
+            self.on_status(self.idle_status())
+        return was_latched
+
+    def daemon_status(self) -> dict[str, Any]:
+        with self._lock:
+            current = self._current
+            estop = self._estop_reason
+        state = "estopped" if estop is not None else "busy" if current is not None else "idle"
+        return {
+            "state": state,
+            "estop": estop,
+            "current": current.id if current else None,
+            "queued": len(self.queue),
+            "queue_size": self.queue.capacity,
+            "backend": self.config.robot.backend,
+            "pid": os.getpid(),
+            "uptime_s": round(time.monotonic() - self.started, 3),
+        }
+
+    def health(self) -> tuple[bool, dict[str, Any]]:
+        robot: dict[str, Any] = {"ok": False, "backend": self.config.robot.backend}
+        try:
+            robot.update(ok=True, state=self.robot.state().to_dict())
+        except Exception as exc:
+            robot["detail"] = f"cannot read the robot state: {exc}"
+        speech: dict[str, Any] = {"ok": self.speech is not None}
+        if self.speech is not None:
+            try:
+                speech.update(self.speech.health())
+            except Exception as exc:
+                speech.update(ok=False, detail=f"speech health check failed: {exc}")
+        else:
+            speech["detail"] = self.speech_problem
+        components = {
+            "worker": {"ok": self.alive(), **({"detail": self._worker_error} if self._worker_error else {})},
+            "translator": {
+                "ok": self.translator is not None,
+                "model": getattr(self.translator, "model_name", None) or self.config.translator.model or "embedded",
+            },
+            "robot": robot,
+            "audit": {"ok": self.audit._file is not None, "path": str(self.audit.path)},
+            "speech": speech,
+            "estop": {"ok": self._estop_reason is None, "latched": self._estop_reason is not None},
+        }
+        # Speech is optional: the daemon is healthy without a microphone.
+        healthy = all(components[k]["ok"] for k in ("worker", "translator", "robot", "audit"))
+        return healthy, components
+
+    def listen(self) -> None:
+        if self.speech is None:
+            raise ProtocolError(
+                "unavailable",
+                f"speech input is not running: {self.speech_problem}",
+                "see `nrtrans health`; submit text with `nrtrans send` meanwhile",
+            )
+        self.speech.listen_now()
+
+    def idle_status(self) -> str:
+        return f"ready: {self.config.robot.backend} backend, listening on {self.config.socket_path()}"
+
+    # -- the worker ---------------------------------------------------------------------------
+
+    def _work(self) -> None:
+        while True:
+            task = self.queue.get()
+            if task is None:
+                return
+            with self._lock:
+                self._current = task
+            try:
+                self._run(task)
+            except AuditError as exc:
+                # Without an audit trail nothing may move: stop and report unhealthy.
+                self._stop_robot()
+                self._worker_error = str(exc.strerror)
+                log.error("audit log failed; the worker stops: %s", exc.strerror)
+                return
+            except Exception as exc:
+                log.exception("task %s failed inside the daemon", task.id)
+                self._stop_robot()
+                self._finish(task, TaskState.FAILED, f"internal error: {exc}")
+            finally:
+                with self._lock:
+                    self._current = None
+            self.on_status(
+                self.idle_status()
+                if self._estop_reason is None
+                else f"EMERGENCY STOP latched: {self._estop_reason}; send reset to resume"
+            )
+
+    def _run(self, task: Task) -> None:
+        start = time.monotonic()
+        self.on_status(f"task {task.id}: {task.text or 'RSL program'}")
+        known = self._known_objects()
+        if task.cancel.is_set():
+            self._finish(task, TaskState.CANCELLED, task.cancel.reason)
+            return
+        plan = self._translate(task, known, start) if task.text is not None else self._compile(task, known, start)
+        if plan is None:
+            return
+        task.program = plan.to_rsl()
+        task.plan = plan.to_list()
+        self.events.publish("verified", task.id, program=task.program, plan=task.plan)
+        if task.cancel.is_set():
+            self._finish(task, TaskState.CANCELLED, task.cancel.reason)
+            return
+        task.state = TaskState.EXECUTING
+        # The plan is on disk before the first command reaches the robot.
+        self.audit.write(task.record())
+        self._execute(task, plan, start)
+
+    def _translate(self, task: Task, known: list[str], start: float) -> Any:
+        assert task.text is not None
+        task.state = TaskState.TRANSLATING
+        self.audit.write(task.record())
+        self.events.publish("translating", task.id, text=task.text)
+
+        def on_attempt(attempt: Any) -> None:
+            entry = {
+                "pass": len(task.attempts) + 1,
+                "program": attempt.program,
+                "diagnostics": [d.to_dict() for d in attempt.diagnostics],
+            }
+            task.attempts.append(entry)
+            self.events.publish("attempt", task.id, **entry)
+
+        result = self.translator.translate(task.text, known_objects=known, on_attempt=on_attempt)
+        task.mark("translate_ms", start)
+        task.model = getattr(result, "model", None)
+        for name, value in (getattr(result, "timings_ms", None) or {}).items():
+            task.timings_ms[f"translator.{name}"] = value
+        if len(task.attempts) < len(result.attempts):
+            # A translator that reported its attempts only at the end.
+            task.attempts[:] = [
+                {"pass": i, "program": a.program, "diagnostics": [d.to_dict() for d in a.diagnostics]}
+                for i, a in enumerate(result.attempts, 1)
+            ]
+        if task.cancel.is_set():
+            self._finish(task, TaskState.CANCELLED, task.cancel.reason)
+            return None
+        if not result.verified or result.plan is None:
+            last = task.attempts[-1]["diagnostics"] if task.attempts else []
+            self._reject(task, f"no verified program after {result.passes} attempt(s); nothing moved", last)
+            return None
+        return result.plan
+
+    def _compile(self, task: Task, known: list[str], start: float) -> Any:
+        from rsl.compiler import compile_program
+
+        assert task.rsl is not None
+        result = compile_program(task.rsl, self.profile, known)
+        task.mark("compile_ms", start)
+        entry = {"pass": 1, "program": task.rsl, "diagnostics": [d.to_dict() for d in result.diagnostics]}
+        task.attempts.append(entry)
+        self.events.publish("attempt", task.id, **entry)
+        if not result.ok:
+            self._reject(task, "the program does not compile; nothing moved", entry["diagnostics"])
+            return None
+        return result.plan
+
+    def _execute(self, task: Task, plan: Any, start: float) -> None:
+        from agent.executor import execute
+
+        def on_step(step: Any) -> None:
+            number = step.index + 1
+            if step.outcome is None:
+                if "first_command_ms" not in task.timings_ms:
+                    task.mark("first_command_ms", start)
+                self.events.publish("executing", task.id, step=number, total=step.total, statement=step.statement)
+                return
+            outcome = {"status": step.outcome.status.value, "reason": step.outcome.reason}
+            task.steps.append(
+                {
+                    "step": number,
+                    "statement": step.statement,
+                    "outcome": outcome,
+                    "t_ms": round((time.monotonic() - start) * 1000.0, 3),
+                }
+            )
+            self.audit.write(task.record())
+            self.events.publish(
+                "step", task.id, step=number, total=step.total, statement=step.statement, outcome=outcome
+            )
+
+        result = execute(plan, self.robot, self.profile, cancel=task.cancel, on_event=on_step)
+        task.mark("total_ms", start)
+        status = getattr(result.status, "value", result.status)
+        final_state = result.final_state.to_dict() if result.final_state is not None else None
+        if status == "done":
+            self._finish(task, TaskState.DONE, "", robot_state=final_state)
+        elif status == "cancelled":
+            self._finish(task, TaskState.CANCELLED, task.cancel.reason or _last_reason(result), robot_state=final_state)
+        else:
+            self._finish(task, TaskState.FAILED, _last_reason(result) or "a step failed", robot_state=final_state)
+
+    # -- helpers ---------------------------------------------------------------------------
+
+    def _reject(self, task: Task, reason: str, diagnostics: list[dict[str, Any]]) -> None:
+        with self._lock:
+            if task.state.finished:
+                return
+            task.state = TaskState.REJECTED
+            task.reason = reason
+        self.audit.write(task.record(), final=True)
+        self.events.publish("rejected", task.id, reason=reason, diagnostics=diagnostics)
+
+    def _finish(self, task: Task, state: TaskState, reason: str, *, robot_state: dict[str, Any] | None = None) -> None:
+        with self._lock:
+            if task.state.finished:
+                return
+            task.state = state
+            task.reason = reason
+        self.audit.write(task.record(), final=True)
+        if state is TaskState.DONE:
+            self.events.publish("done", task.id, state=robot_state)
+        else:
+            self.events.publish(state.value, task.id, reason=reason, state=robot_state)
+
+    def _remember(self, task: Task) -> None:
+        self._tasks[task.id] = task
+        while len(self._tasks) > self.config.tasks.history + self.queue.capacity + 1:
+            oldest = next(iter(self._tasks.values()))
+            if not oldest.state.finished:
+                break
+            self._tasks.popitem(last=False)
+
+    def _known_objects(self) -> list[str]:
+        try:
+            return [name for name, _x, _y in self.robot.state().known_objects]
+        except Exception as exc:
+            log.warning("cannot read the known objects from the robot: %s", exc)
+            return []
+
+    def _stop_robot(self) -> None:
+        if self.robot is None:
+            return
+        try:
+            self.robot.stop()
+        except Exception:
+            log.exception("robot.stop() failed")
+
+    def _start_speech(self) -> None:
+        try:
+            from agent.daemon.voice import start_speech
+
+            self.speech = start_speech(self.config.speech.options, self._on_transcript, self._on_speech_event)
+        except Exception as exc:
+            self.speech = None
+            self.speech_problem = f"{type(exc).__name__}: {exc}"
+            log.warning("speech input is off: %s; the socket API keeps working", self.speech_problem)
+
+    def _on_transcript(self, transcript: Any) -> None:
+        text = str(transcript.text).strip()
+        if not text:
+            return
+        try:
+
+            def announce(task: Task) -> None:
+                self.events.publish("heard", task.id, text=text)
+
+            self.submit(source="voice", text=text[: self.config.api.max_task_chars], before_queue=announce)
+        except ProtocolError as exc:
+            log.warning("spoken task %r not queued: %s", text, exc.message)
+            self.events.publish("speech", None, state="dropped", detail={"text": text, "reason": exc.message})
+
+    def _on_speech_event(self, event: Any) -> None:
+        name = getattr(event, "name", None) or getattr(event, "kind", None) or str(event)
+        detail = event.to_dict() if hasattr(event, "to_dict") else {}
+        self.events.publish("speech", None, state=str(name), detail=detail)
+
+
+def _last_reason(result: Any) -> str:
+    for outcome in reversed(list(getattr(result, "outcomes", ()) or ())):
+        if getattr(outcome, "reason", ""):
+            return str(outcome.reason)
+    return ""
+
+
+def _quietly(action: Callable[[], Any]) -> None:
+    try:
+        action()
+    except Exception:
+        log.exception("error while shutting down")
+
+
+def _load_profile(path: str) -> Any:
+    from rsl.profile import ProfileError, load_profile
+
+    try:
+        return load_profile(path or None)
+    except ProfileError as exc:
+        raise StartupError(f"{exc}\n  = help: fix the profile or set robot.profile in the config") from exc
+
+
+def _load_translator(config: Config, profile: Any) -> Any:
+    settings = config.translator
+    if settings.model and not Path(settings.model).expanduser().is_file():
+        raise StartupError(
+            f"the model file {settings.model} does not exist\n"
+            "  = help: fetch it with `nrtrans models fetch`, fix translator.model in the config, "
+            "or leave it empty to use the embedded model"
+        )
+    if settings.adapter and not Path(settings.adapter).expanduser().is_file():
+        raise StartupError(
+            f"the adapter file {settings.adapter} does not exist\n"
+            "  = help: fix translator.adapter in the config, or leave it empty"
+        )
+    try:
+        from agent.translate import Translator
+
+        return Translator.load(
+            profile,
+            model=settings.model or None,
+            adapter=settings.adapter or None,
+            grammar=settings.grammar,
+            max_passes=settings.max_passes,
+            endpoint=settings.endpoint or None,
+        )
+    except Exception as exc:
+        raise StartupError(
+            f"cannot load the translator: {exc}\n  = help: check translator.model and translator.adapter in the config"
+        ) from exc
+
+
+def _open_robot(config: Config, profile: Any) -> Any:
+    settings = config.robot
+    try:
+        from agent.backends import open_robot
+
+        options: dict[str, Any] = {}
+        if settings.backend == "sim":
+            options = {"scene": settings.scene or None, "realtime_factor": settings.realtime_factor}
+        return open_robot(settings.backend, profile, **options)
+    except Exception as exc:
+        raise StartupError(
+            f"cannot open the {settings.backend} backend: {exc}\n"
+            "  = help: check [robot] in the config, or use --backend sim"
+        ) from exc
