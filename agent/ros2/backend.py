@@ -1,0 +1,471 @@
+"""`Ros2Robot`: the robot interface over standard ROS 2 topics and services.
+
+Every name comes from the profile's `[ros]` table (see `config.py` and
+docs/ros2.md). The base is driven in closed loop on odometry; the head and
+gripper through joint trajectories checked against joint states; `goto` and
+`approach` through a goal pose whose completion is judged from odometry.
+
+Safety rules, each enforced in one place:
+- every base motion ends in a zero Twist, however it ends (done, cancel,
+  emergency stop, error, timeout, stale odometry);
+- odometry older than `odom_timeout` while moving stops the base and fails
+  the step;
+- `stop()` takes the same lock as the control loops' publishing, so no
+  motion command can slip out after the emergency stop's zero Twist.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+from collections.abc import Callable
+
+from agent.robot import CancelToken, Outcome, Pose, RobotState
+from agent.ros2.config import RosConfig
+from agent.ros2.geometry import footprint_radius, wrap_angle
+from agent.ros2.link import Odometry, RobotLink, ServiceError
+from agent.ros2.messages import FormatError, decode_held, decode_objects
+from agent.ros2.motion import Limits, move_budget, next_speed
+from rsl.profile import Profile
+
+CONTROL_PERIOD = 0.02  # s, 50 Hz: well inside the 0.2 s the robot has to stop after a cancel
+LINEAR_TOLERANCE = 0.002  # m; the contract is 2 cm, the rest is margin for coasting
+ANGULAR_TOLERANCE = math.radians(0.15)  # the contract is 1 degree
+GOAL_TOLERANCE = 0.03  # m, for goal poses, which the robot's own controller settles
+GOAL_HEADING_TOLERANCE = math.radians(2.0)
+JOINT_TOLERANCE = 0.01  # rad, or m for the gripper
+STILL_LINEAR = 0.01  # m/s; slower than this counts as standing still
+STILL_ANGULAR = 0.02  # rad/s
+DISCOVERY_WAIT = 3.0  # s to wait for a subscriber before calling a topic dead
+
+
+class RobotUnavailable(RuntimeError):
+    """No robot answers on the configured topics."""
+
+
+class StepFailure(Exception):
+    """Ends a step with a failed outcome; the message is the reason."""
+
+
+class Ros2Robot:
+    def __init__(self, profile: Profile, *, config: RosConfig | None = None,
+                 node_name: str = "nrtrans_backend", connect_timeout: float | None = None) -> None:
+        self.profile = profile
+        self.config = config or RosConfig.from_profile(profile)
+        motion = profile.motion
+        self._linear = Limits(motion.max_linear_speed, motion.max_linear_accel, gain=3.0, creep=0.02)
+        self._angular = Limits(motion.max_angular_speed, motion.max_angular_accel, gain=3.0, creep=0.03)
+        self._known: dict[str, tuple[float, float]] = {}
+        self._holding: str | None = None
+        self._held_since = 0.0
+        self._stops = 0
+        self._generation = 0
+        self._publish_lock = threading.Lock()
+        self._closed = False
+        self._link = RobotLink(self.config, node_name)
+        wait = self.config.connect_timeout if connect_timeout is None else connect_timeout
+        if self._link.wait_for_odometry(wait) is None:
+            self._link.close()
+            raise RobotUnavailable(
+                f"no robot: no odometry arrived on {self.config.odom} within {wait:g} s.\n"
+                "  Start the robot's driver, or `nrtrans sim-bridge` for the simulator, and check that "
+                "both sides use the same ROS_DOMAIN_ID and ROS_AUTOMATIC_DISCOVERY_RANGE "
+                f"(try `ros2 topic hz {self.config.odom}`)."
+            )
+
+    # -- skills: base ------------------------------------------------------------
+
+    def forward(self, distance: float, *, cancel: CancelToken | None = None) -> Outcome:
+        return self._guarded(cancel, lambda token: self._drive(distance, 1.0, token))
+
+    def backward(self, distance: float, *, cancel: CancelToken | None = None) -> Outcome:
+        return self._guarded(cancel, lambda token: self._drive(distance, -1.0, token))
+
+    def turnleft(self, angle: float, *, cancel: CancelToken | None = None) -> Outcome:
+        return self._guarded(cancel, lambda token: self._turn(angle, 1.0, token))
+
+    def turnright(self, angle: float, *, cancel: CancelToken | None = None) -> Outcome:
+        return self._guarded(cancel, lambda token: self._turn(angle, -1.0, token))
+
+    def goto(self, x: float, y: float, *, cancel: CancelToken | None = None) -> Outcome:
+        def run(token: CancelToken) -> Outcome:
+            self._check_workspace(x, y, f"goto {x:g}, {y:g}")
+            start = self._fresh_odometry().pose
+            far = math.hypot(x - start.x, y - start.y)
+            heading = math.atan2(y - start.y, x - start.x) if far > GOAL_TOLERANCE else start.heading
+            self._drive_to_goal(x, y, heading, token, check_heading=False)
+            return Outcome.done()
+        return self._guarded(cancel, run)
+
+    def approach(self, name: str, *, cancel: CancelToken | None = None) -> Outcome:
+        def run(token: CancelToken) -> Outcome:
+            ox, oy = self._object_position(name)
+            here = self._fresh_odometry().pose
+            away = math.hypot(ox - here.x, oy - here.y)
+            heading = math.atan2(oy - here.y, ox - here.x) if away > 1e-3 else here.heading
+            standoff = self.profile.motion.standoff + self._edge(name, heading + math.pi)
+            x, y = ox - standoff * math.cos(heading), oy - standoff * math.sin(heading)
+            self._check_workspace(x, y, f"the stand-off point in front of {name}")
+            self._drive_to_goal(x, y, heading, token, check_heading=True)
+            return Outcome.done(f"stopped {self.profile.motion.standoff:g} m in front of {name}, facing it")
+        return self._guarded(cancel, run)
+
+    # -- skills: head, perception, gripper ---------------------------------------
+
+    def lookleft(self, angle: float, *, cancel: CancelToken | None = None) -> Outcome:
+        return self._guarded(cancel, lambda token: self._look(angle, 0.0, token))
+
+    def lookright(self, angle: float, *, cancel: CancelToken | None = None) -> Outcome:
+        return self._guarded(cancel, lambda token: self._look(-angle, 0.0, token))
+
+    def lookup(self, angle: float, *, cancel: CancelToken | None = None) -> Outcome:
+        return self._guarded(cancel, lambda token: self._look(0.0, angle, token))
+
+    def lookdown(self, angle: float, *, cancel: CancelToken | None = None) -> Outcome:
+        return self._guarded(cancel, lambda token: self._look(0.0, -angle, token))
+
+    def perceive(self, *, cancel: CancelToken | None = None) -> Outcome:
+        def run(token: CancelToken) -> Outcome:
+            reply = self._link.call_perceive(token)
+            if not reply.success:
+                raise StepFailure(f"perception failed: {reply.message}")
+            seen = decode_objects(reply.message, f"reply of {self.config.perceive_service}").objects
+            self._known.update(seen)
+            if not seen:
+                return Outcome.done("saw no objects")
+            return Outcome.done("saw " + ", ".join(sorted(seen)))
+        return self._guarded(cancel, run)
+
+    def grasp(self, name: str, *, cancel: CancelToken | None = None) -> Outcome:
+        def run(token: CancelToken) -> Outcome:
+            if self._holding_now() is not None:
+                raise StepFailure(f"cannot grasp {name}: already holding {self._holding_now()}; "
+                                  "the gripper holds one object at a time")
+            ox, oy = self._object_position(name)
+            here = self._fresh_odometry().pose
+            away = math.hypot(ox - here.x, oy - here.y)
+            reach = self.profile.motion.reach
+            if away > reach:
+                raise StepFailure(f"{name} is {away:.2f} m away, out of reach {reach:g} m; "
+                                  f"`approach {name};` first")
+            self._check_nearest(name, away, here)
+            self._move_gripper(self.config.gripper_open_position, token)
+            reply = self._link.call_grasp(token)
+            if not reply.success:
+                raise StepFailure(f"grasping {name} failed: {reply.message}")
+            held = decode_held(reply.message, f"reply of {self.config.grasp_service}")
+            self._holding, self._held_since = held, time.monotonic()
+            if held != name:
+                raise StepFailure(f"the gripper closed on {held}, not {name}")
+            return Outcome.done(f"holding {name}")
+        return self._guarded(cancel, run)
+
+    # -- the rest of the robot interface -------------------------------------------
+
+    def stop(self) -> None:
+        with self._publish_lock:
+            self._stops += 1
+            self._link.send_zero_twist()
+            odom = self._link.odometry()
+            if odom is not None:
+                self._link.send_goal(odom.pose.x, odom.pose.y, odom.pose.heading)
+
+    def state(self) -> RobotState:
+        odom = self._link.odometry()
+        pose = odom.pose if odom is not None else Pose(0.0, 0.0, 0.0)
+        joints, _ = self._link.joints()
+        report, _ = self._link.objects()
+        if report is not None:
+            for name in self._known.keys() & report.objects.keys():
+                self._known[name] = report.objects[name]
+        return RobotState(
+            pose=pose,
+            head_pan=joints.get(self.config.head_pan_joint, 0.0),
+            head_tilt=joints.get(self.config.head_tilt_joint, 0.0),
+            holding=self._holding_now(),
+            known_objects=tuple((n, x, y) for n, (x, y) in sorted(self._known.items())),
+        )
+
+    def close(self) -> None:
+        if self._closed:
+            return
+        self._closed = True
+        with self._publish_lock:
+            self._stops += 1
+            self._link.send_zero_twist()
+        # Give DDS a moment to deliver the zero Twist before the participant goes away.
+        time.sleep(0.05)
+        self._link.close()
+
+    def __enter__(self) -> Ros2Robot:
+        return self
+
+    def __exit__(self, *_exc: object) -> None:
+        self.close()
+
+    # -- internals -------------------------------------------------------------------
+
+    def _guarded(self, cancel: CancelToken | None, body: Callable[[CancelToken], Outcome]) -> Outcome:
+        """Run one step so that it always returns an Outcome and always leaves the base stopped."""
+        token = cancel or CancelToken()
+        if self._closed:
+            return Outcome.failed("the ROS 2 backend is closed")
+        generation = self._stops
+        self._generation = generation
+        try:
+            if token.is_set():
+                return Outcome.cancelled(token.reason)
+            return body(token)
+        except _Cancelled as exc:
+            return Outcome.cancelled(str(exc))
+        except (StepFailure, ServiceError, FormatError) as exc:
+            return Outcome.failed(str(exc))
+        except Exception as exc:  # the robot must stop whatever went wrong
+            return Outcome.failed(f"internal error in the ROS 2 backend: {type(exc).__name__}: {exc}")
+        finally:
+            with self._publish_lock:
+                self._link.send_zero_twist()
+
+    def _drive(self, distance: float, direction: float, token: CancelToken) -> Outcome:
+        start = self._fresh_odometry().pose
+        ux, uy = math.cos(start.heading), math.sin(start.heading)
+
+        def progress(pose: Pose) -> float:
+            return direction * ((pose.x - start.x) * ux + (pose.y - start.y) * uy)
+
+        def command(speed: float, pose: Pose) -> tuple[float, float]:
+            # Hold the start heading so a long drive stays straight.
+            hold = max(-0.2, min(0.2, 2.0 * wrap_angle(start.heading - pose.heading)))
+            return direction * speed, hold
+
+        budget = move_budget(distance, self._linear.max_speed, self._linear.max_accel,
+                             self.profile.motion.timeout_margin)
+        self._control(distance, progress, command, self._linear, LINEAR_TOLERANCE, budget, token,
+                      what=f"{'forward' if direction > 0 else 'backward'} {distance:g} m")
+        return Outcome.done()
+
+    def _turn(self, angle: float, direction: float, token: CancelToken) -> Outcome:
+        last = [self._fresh_odometry().pose.heading]
+        turned = [0.0]
+
+        def progress(pose: Pose) -> float:
+            # Accumulate small increments so turns of several full circles count right.
+            turned[0] += wrap_angle(pose.heading - last[0])
+            last[0] = pose.heading
+            return direction * turned[0]
+
+        def command(speed: float, _pose: Pose) -> tuple[float, float]:
+            return 0.0, direction * speed
+
+        budget = move_budget(angle, self._angular.max_speed, self._angular.max_accel,
+                             self.profile.motion.timeout_margin)
+        self._control(angle, progress, command, self._angular, ANGULAR_TOLERANCE, budget, token,
+                      what=f"turn{'left' if direction > 0 else 'right'} {angle:g} rad")
+        return Outcome.done()
+
+    def _control(self, amount: float, progress: Callable[[Pose], float],
+                 command: Callable[[float, Pose], tuple[float, float]], limits: Limits,
+                 tolerance: float, budget: float, token: CancelToken, what: str) -> None:
+        self._require_listener(lambda: self._link.listeners("cmd_vel"), self.config.cmd_vel)
+        deadline = time.monotonic() + budget
+        speed = 0.0
+        while True:
+            odom = self._fresh_odometry()
+            remaining = amount - progress(odom.pose)
+            if abs(remaining) <= tolerance:
+                break
+            self._check_interrupts(token)
+            if time.monotonic() > deadline:
+                raise StepFailure(f"{what} timed out after {budget:.1f} s with {abs(remaining):.3f} "
+                                  "still to go; the base was stopped. Is something blocking the robot?")
+            speed = next_speed(remaining, speed, limits, CONTROL_PERIOD)
+            linear, angular = command(speed, odom.pose)
+            with self._publish_lock:
+                self._check_interrupts(token)
+                self._link.send_twist(linear, angular)
+            token.wait(CONTROL_PERIOD)
+        with self._publish_lock:
+            self._link.send_zero_twist()
+        self._settle(token)
+
+    def _drive_to_goal(self, x: float, y: float, heading: float, token: CancelToken,
+                       check_heading: bool) -> None:
+        self._require_listener(lambda: self._link.listeners("goal"), self.config.goal_pose)
+        start = self._fresh_odometry().pose
+        far = math.hypot(x - start.x, y - start.y)
+        turning = abs(wrap_angle(math.atan2(y - start.y, x - start.x) - start.heading)) + math.pi
+        motion = self.profile.motion
+        budget = (move_budget(far, motion.max_linear_speed, motion.max_linear_accel, motion.timeout_margin)
+                  + turning / motion.max_angular_speed)
+        deadline = time.monotonic() + budget
+        with self._publish_lock:
+            self._check_interrupts(token)
+            self._link.send_goal(x, y, heading)
+        reached = False
+        try:
+            while True:
+                self._check_interrupts(token)
+                odom = self._fresh_odometry()
+                off = math.hypot(x - odom.pose.x, y - odom.pose.y)
+                turned = abs(wrap_angle(heading - odom.pose.heading))
+                still = abs(odom.linear) < STILL_LINEAR and abs(odom.angular) < STILL_ANGULAR
+                facing = not check_heading or turned <= GOAL_HEADING_TOLERANCE
+                if off <= GOAL_TOLERANCE and still and facing:
+                    reached = True
+                    return
+                if time.monotonic() > deadline:
+                    raise StepFailure(f"did not reach ({x:.2f}, {y:.2f}) within {budget:.1f} s; "
+                                      f"stopped {off:.2f} m from it. Is the path blocked?")
+                token.wait(CONTROL_PERIOD)
+        finally:
+            if not reached:
+                self._cancel_goal()
+
+    def _cancel_goal(self) -> None:
+        # A goal at the current pose is how a plain goal_pose follower is told to stop;
+        # the zero Twist that follows covers drivers that let cmd_vel override goals.
+        with self._publish_lock:
+            odom = self._link.odometry()
+            if odom is not None:
+                self._link.send_goal(odom.pose.x, odom.pose.y, odom.pose.heading)
+            self._link.send_zero_twist()
+
+    def _look(self, pan_by: float, tilt_by: float, token: CancelToken) -> Outcome:
+        pan_joint, tilt_joint = self.config.head_pan_joint, self.config.head_tilt_joint
+        joints = self._fresh_joints([pan_joint, tilt_joint])
+        notes = []
+        targets = []
+        for joint, now, by in (("pan", joints[pan_joint], pan_by), ("tilt", joints[tilt_joint], tilt_by)):
+            low, high = self.profile.head[joint]
+            wanted = now + by
+            target = min(max(wanted, low), high)
+            if by and abs(target - wanted) > 1e-9:
+                notes.append(f"{joint} limited to {target:g} rad, its joint limit")
+            targets.append(target)
+        pan, tilt = targets
+        travel = max(abs(pan - joints[pan_joint]), abs(tilt - joints[tilt_joint]))
+        duration = travel / self.profile.motion.max_head_speed
+        self._require_listener(lambda: self._link.listeners("head"),
+                               self.config.head_trajectory)
+        self._link.send_head(pan, tilt, duration)
+        self._await_joints({pan_joint: pan, tilt_joint: tilt}, duration, token, "head")
+        return Outcome.done("; ".join(notes))
+
+    def _move_gripper(self, position: float, token: CancelToken) -> None:
+        joint = self.config.gripper_joint
+        now = self._fresh_joints([joint])[joint]
+        if abs(now - position) <= JOINT_TOLERANCE:
+            return
+        self._require_listener(lambda: self._link.listeners("gripper"),
+                               self.config.gripper_trajectory)
+        self._link.send_gripper(position, 0.5)
+        self._await_joints({joint: position}, 0.5, token, "gripper")
+
+    def _await_joints(self, targets: dict[str, float], duration: float, token: CancelToken,
+                      what: str) -> None:
+        budget = 1.5 * duration + 1.0 + self.profile.motion.timeout_margin
+        deadline = time.monotonic() + budget
+        while True:
+            joints = self._fresh_joints(list(targets))
+            if all(abs(joints[j] - t) <= JOINT_TOLERANCE for j, t in targets.items()):
+                return
+            self._check_interrupts(token)
+            if time.monotonic() > deadline:
+                where = ", ".join(f"{j} at {joints[j]:.3f} (wanted {t:.3f})" for j, t in targets.items())
+                raise StepFailure(f"the {what} did not reach its target within {budget:.1f} s: {where}")
+            token.wait(CONTROL_PERIOD)
+
+    def _fresh_odometry(self) -> Odometry:
+        odom = self._link.odometry()
+        limit = self.config.odom_timeout
+        age = math.inf if odom is None else time.monotonic() - odom.received
+        if odom is None or age > limit:
+            with self._publish_lock:
+                self._link.send_zero_twist()
+            seen = "never arrived" if odom is None else f"last arrived {age:.2f} s ago"
+            raise StepFailure(f"odometry on {self.config.odom} is stale ({seen}, limit {limit:g} s); "
+                              "the base was stopped. Check the robot's driver and the network link.")
+        assert odom is not None
+        return odom
+
+    def _fresh_joints(self, names: list[str]) -> dict[str, float]:
+        joints, received = self._link.joints()
+        missing = [n for n in names if n not in joints]
+        if missing:
+            raise StepFailure(f"no position for joint(s) {', '.join(missing)} on {self.config.joint_states}; "
+                              "check the joint names in the profile's [ros] table and that the "
+                              "joint state publisher runs")
+        age = time.monotonic() - received
+        if age > max(1.0, 2 * self.config.odom_timeout):
+            raise StepFailure(f"joint states on {self.config.joint_states} are stale "
+                              f"(last arrived {age:.2f} s ago)")
+        return {n: joints[n] for n in names}
+
+    def _settle(self, token: CancelToken) -> None:
+        """Wait briefly for the base to stand still, so the next step starts from rest."""
+        deadline = time.monotonic() + 1.0
+        while time.monotonic() < deadline and not token.is_set():
+            odom = self._fresh_odometry()
+            if abs(odom.linear) < STILL_LINEAR and abs(odom.angular) < STILL_ANGULAR:
+                return
+            token.wait(CONTROL_PERIOD)
+
+    def _check_interrupts(self, token: CancelToken) -> None:
+        if token.is_set():
+            raise _Cancelled(token.reason or "cancelled")
+        if self._stops != self._generation:
+            raise _Cancelled("emergency stop")
+
+    def _require_listener(self, count: Callable[[], int], topic: str) -> None:
+        deadline = time.monotonic() + DISCOVERY_WAIT
+        while count() == 0:
+            if time.monotonic() > deadline:
+                raise StepFailure(f"nobody subscribes to {topic}: the robot would not receive the command. "
+                                  "Is its controller running and is the topic name in the profile right?")
+            time.sleep(0.05)
+
+    def _object_position(self, name: str) -> tuple[float, float]:
+        report, error = self._link.objects()
+        if report is not None and name in report.objects:
+            return report.objects[name]
+        if name in self._known:
+            return self._known[name]
+        known = sorted(set(self._known) | set(report.objects if report else ()))
+        hint = f"known objects: {', '.join(known)}" if known else "no objects are known yet"
+        extra = f" (the objects topic sent malformed data: {error})" if error else ""
+        raise StepFailure(f"unknown object `{name}`: {hint}{extra}; `perceive;` while facing it first")
+
+    def _edge(self, name: str, direction: float) -> float:
+        """How far the object's edge is from its centre, seen from `direction`; 0 if unknown."""
+        report, _ = self._link.objects()
+        footprint = report.footprints.get(name) if report is not None else None
+        if footprint is None:
+            return 0.0
+        return footprint_radius(footprint.shape, footprint.size, footprint.yaw, direction)
+
+    def _check_nearest(self, name: str, away: float, here: Pose) -> None:
+        report, _ = self._link.objects()
+        if report is None:
+            return
+        for other, (x, y) in report.objects.items():
+            if other != name and other != report.held and math.hypot(x - here.x, y - here.y) < away:
+                raise StepFailure(f"{other} is nearer to the gripper than {name}, so the grasp would "
+                                  f"take {other}; `approach {name};` first")
+
+    def _check_workspace(self, x: float, y: float, what: str) -> None:
+        (xlo, xhi), (ylo, yhi) = self.profile.workspace["x"], self.profile.workspace["y"]
+        if not (xlo <= x <= xhi and ylo <= y <= yhi):
+            raise StepFailure(f"{what} is at ({x:.2f}, {y:.2f}), outside the workspace "
+                              f"x {xlo:g}..{xhi:g}, y {ylo:g}..{yhi:g}")
+
+    def _holding_now(self) -> str | None:
+        report, _ = self._link.objects()
+        received = self._link.objects_received()
+        if report is not None and received > self._held_since:
+            return report.held
+        return self._holding
+
+
+class _Cancelled(Exception):
+    """Ends a step with a cancelled outcome; the message is the reason."""

@@ -1,0 +1,224 @@
+"""`SimBridge`: the pybullet robot served over the ROS 2 interfaces a real robot offers.
+
+It plays the robot's drivers: a base controller on cmd_vel (with a command
+timeout, as diff-drive controllers have), odometry and joint states at a fixed
+rate, joint trajectory controllers for the head and gripper, a goal-pose
+follower, and the perceive and grasp services and objects topic that
+docs/ros2.md defines. The backend cannot tell it from a robot.
+
+All callbacks and the physics run on the one executor thread, so the world is
+never touched from two threads at once.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+from agent.ros2.config import RosConfig
+from agent.ros2.geometry import quaternion_from_yaw, wrap_angle, yaw_from_quaternion
+from agent.ros2.goal_follower import Goal, GoalFollower
+from agent.ros2.messages import Footprint, encode_held, encode_objects
+from agent.ros2.node_thread import NodeThread
+from agent.sim.world import GRASP_BEARING, SimWorld
+from rsl.profile import Profile
+
+PUBLISH_HZ = 50.0
+OBJECTS_EVERY = 10  # ticks: the objects topic goes out at 5 Hz
+CMD_VEL_TIMEOUT = 0.5  # s of wall time without cmd_vel before the base is stopped
+MAX_CATCH_UP = 0.25  # s of simulated time one tick may make up after a stall
+GRIPPER_SPEED = 0.2  # m/s, the finger speed the joint state reports
+RESET_SERVICE = "/sim_bridge/reset"
+
+
+class SimBridge:
+    def __init__(self, profile: Profile, world_factory: Any, *, realtime_factor: float = 1.0,
+                 config: RosConfig | None = None, node_name: str = "nrtrans_sim_bridge") -> None:
+        from geometry_msgs.msg import PoseStamped, Twist
+        from nav_msgs.msg import Odometry
+        from rclpy.qos import QoSProfile, ReliabilityPolicy
+        from sensor_msgs.msg import JointState
+        from std_msgs.msg import String
+        from std_srvs.srv import Trigger
+        from trajectory_msgs.msg import JointTrajectory
+
+        if realtime_factor <= 0:
+            raise ValueError(f"the real-time factor must be positive, got {realtime_factor:g}")
+        self.profile = profile
+        self.config = config or RosConfig.from_profile(profile)
+        self.realtime_factor = realtime_factor
+        self._new_world = world_factory
+        self.world: SimWorld = world_factory()
+        self._follower = GoalFollower(profile.motion)
+        self._reset_state()
+        self._odometry_type, self._joint_state_type, self._string_type = Odometry, JointState, String
+
+        self._ros = NodeThread(node_name)
+        node = self._ros.node
+        reliable = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
+        cfg = self.config
+        self._odom = node.create_publisher(Odometry, cfg.odom, reliable)
+        self._joints = node.create_publisher(JointState, cfg.joint_states, reliable)
+        self._objects = node.create_publisher(String, cfg.objects_topic, reliable)
+        node.create_subscription(Twist, cfg.cmd_vel, self._on_cmd_vel, reliable)
+        node.create_subscription(PoseStamped, cfg.goal_pose, self._on_goal, reliable)
+        node.create_subscription(JointTrajectory, cfg.head_trajectory, self._on_head, reliable)
+        node.create_subscription(JointTrajectory, cfg.gripper_trajectory, self._on_gripper, reliable)
+        node.create_service(Trigger, cfg.perceive_service, self._on_perceive)
+        node.create_service(Trigger, cfg.grasp_service, self._on_grasp)
+        node.create_service(Trigger, RESET_SERVICE, self._on_reset)
+        self._timer = node.create_timer(1.0 / PUBLISH_HZ, self._tick)
+
+    def _reset_state(self) -> None:
+        self._cmd = (0.0, 0.0)
+        self._cmd_at = -math.inf
+        self._follower.clear()
+        self._gripper = self.config.gripper_open_position
+        self._gripper_target = self._gripper
+        self._ticks = 0
+        self._last_tick = time.monotonic()
+        self._owed = 0.0
+
+    # -- the physics clock -----------------------------------------------------------
+
+    def _tick(self) -> None:
+        now = time.monotonic()
+        wall = now - self._last_tick
+        self._last_tick = now
+        world = self.world
+        self._owed = min(self._owed + wall * self.realtime_factor, MAX_CATCH_UP)
+        steps = int(self._owed / world.dt)
+        self._owed -= steps * world.dt
+        if self._follower.goal is not None:
+            world.set_base_velocity(*self._follower.command(world.base_pose(), steps * world.dt))
+        elif now - self._cmd_at > CMD_VEL_TIMEOUT:
+            world.set_base_velocity(0.0, 0.0)
+        else:
+            world.set_base_velocity(*self._cmd)
+        if steps:
+            world.step(steps)
+        self._move_gripper(steps * world.dt)
+        self._publish_state()
+        self._ticks += 1
+        if self._ticks % OBJECTS_EVERY == 0:
+            self._publish_objects()
+
+    def _move_gripper(self, elapsed: float) -> None:
+        step = GRIPPER_SPEED * elapsed
+        self._gripper += max(-step, min(step, self._gripper_target - self._gripper))
+
+    def _publish_state(self) -> None:
+        world, cfg = self.world, self.config
+        stamp = self._ros.node.get_clock().now().to_msg()
+        pose = world.base_pose()
+        linear, angular = world.base_velocity()
+        odom = self._odometry_type()
+        odom.header.stamp = stamp
+        odom.header.frame_id = cfg.world_frame
+        odom.child_frame_id = "base_link"
+        odom.pose.pose.position.x, odom.pose.pose.position.y = pose.x, pose.y
+        qx, qy, qz, qw = quaternion_from_yaw(pose.heading)
+        orientation = odom.pose.pose.orientation
+        orientation.x, orientation.y, orientation.z, orientation.w = qx, qy, qz, qw
+        odom.twist.twist.linear.x, odom.twist.twist.angular.z = linear, angular
+        self._odom.publish(odom)
+        pan, tilt = world.head()
+        joints = self._joint_state_type()
+        joints.header.stamp = stamp
+        joints.name = [cfg.head_pan_joint, cfg.head_tilt_joint, cfg.gripper_joint]
+        joints.position = [float(pan), float(tilt), float(self._gripper)]
+        self._joints.publish(joints)
+
+    def _publish_objects(self) -> None:
+        scene = self.world.scene
+        footprints = {o.name: Footprint(o.shape, (o.size[0], o.size[1]), o.yaw) for o in scene.objects}
+        text = encode_objects(self.world.objects(), self.world.holding, self.config.world_frame, footprints)
+        self._objects.publish(self._string_type(data=text))
+
+    # -- commands ----------------------------------------------------------------------
+
+    def _on_cmd_vel(self, msg: Any) -> None:
+        # Like a twist multiplexer: a direct velocity command overrides a goal in progress.
+        self._follower.clear()
+        self._cmd = (float(msg.linear.x), float(msg.angular.z))
+        self._cmd_at = time.monotonic()
+        self.world.set_base_velocity(*self._cmd)
+
+    def _on_goal(self, msg: Any) -> None:
+        frame = msg.header.frame_id
+        if frame and frame not in (self.config.world_frame, "map"):
+            self._ros.node.get_logger().warning(
+                f"ignored a goal in frame `{frame}`; goals must be in `{self.config.world_frame}`")
+            return
+        q = msg.pose.orientation
+        self._follower.set(Goal(float(msg.pose.position.x), float(msg.pose.position.y),
+                                yaw_from_quaternion(q.x, q.y, q.z, q.w)))
+
+    def _on_head(self, msg: Any) -> None:
+        target = self._trajectory_end(msg)
+        pan, tilt = self.world.head_target
+        self.world.set_head_target(target.get(self.config.head_pan_joint, pan),
+                                   target.get(self.config.head_tilt_joint, tilt))
+
+    def _on_gripper(self, msg: Any) -> None:
+        target = self._trajectory_end(msg).get(self.config.gripper_joint)
+        if target is None:
+            return
+        cfg = self.config
+        closed = abs(target - cfg.gripper_closed_position) < abs(target - cfg.gripper_open_position)
+        self.world.set_gripper(closed)
+        self._gripper_target = cfg.gripper_closed_position if closed else cfg.gripper_open_position
+
+    @staticmethod
+    def _trajectory_end(msg: Any) -> dict[str, float]:
+        """The final point of a trajectory; this controller goes there at its own joint speed."""
+        if not msg.points:
+            return {}
+        return {name: float(p) for name, p in zip(msg.joint_names, msg.points[-1].positions, strict=False)}
+
+    # -- services ----------------------------------------------------------------------
+
+    def _on_perceive(self, _request: Any, response: Any) -> Any:
+        seen = self.world.visible_objects()
+        response.success = True
+        response.message = encode_objects(seen, frame=self.config.world_frame)
+        return response
+
+    def _on_grasp(self, _request: Any, response: Any) -> Any:
+        world = self.world
+        pose = world.base_pose()
+        reach = self.profile.motion.reach
+        candidates = []
+        for name, (x, y, _z) in world.objects().items():
+            obj = world.scene.object(name)
+            away = math.hypot(x - pose.x, y - pose.y)
+            bearing = abs(wrap_angle(math.atan2(y - pose.y, x - pose.x) - pose.heading))
+            if obj is not None and obj.graspable and name != world.holding and away <= reach \
+                    and bearing <= GRASP_BEARING:
+                candidates.append((away, name))
+        if not candidates:
+            response.success = False
+            response.message = f"no graspable object within reach {reach:g} m in front of the gripper"
+            return response
+        name = min(candidates)[1]
+        outcome = world.grasp(name)
+        response.success = outcome.ok
+        response.message = encode_held(name) if outcome.ok else outcome.reason
+        if outcome.ok:
+            self._gripper_target = self.config.gripper_closed_position
+        self._last_tick = time.monotonic()
+        return response
+
+    def _on_reset(self, _request: Any, response: Any) -> Any:
+        self.world.close()
+        self.world = self._new_world()
+        self._reset_state()
+        response.success = True
+        response.message = "the simulated world is back at the scene's start"
+        return response
+
+    def close(self) -> None:
+        self._ros.close()
+        self.world.set_base_velocity(0.0, 0.0)
+        self.world.close()

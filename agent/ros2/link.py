@@ -1,0 +1,224 @@
+"""The backend's ROS 2 plumbing: publishers, subscriptions, service clients, and
+the latest odometry, joint states and object report, each with its arrival time.
+
+The skill logic in `backend.py` reads snapshots from here and never sees rclpy
+types, which keeps the control loops short and the safety rules in one place.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+from dataclasses import dataclass
+
+from agent.robot import CancelToken, Pose
+from agent.ros2.config import RosConfig
+from agent.ros2.geometry import quaternion_from_yaw, yaw_from_quaternion
+from agent.ros2.messages import FormatError, ObjectReport, decode_objects
+from agent.ros2.node_thread import NodeThread
+
+
+@dataclass(frozen=True)
+class Odometry:
+    pose: Pose
+    linear: float  # m/s, forward
+    angular: float  # rad/s, counter-clockwise
+    received: float  # time.monotonic() on arrival
+
+
+@dataclass(frozen=True)
+class ServiceReply:
+    success: bool
+    message: str
+
+
+class ServiceError(RuntimeError):
+    """A service that is missing, slow, or was abandoned because of a cancel."""
+
+
+class RobotLink:
+    def __init__(self, config: RosConfig, node_name: str = "nrtrans_backend") -> None:
+        from geometry_msgs.msg import PoseStamped, Twist
+        from nav_msgs.msg import Odometry as OdometryMsg
+        from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
+        from sensor_msgs.msg import JointState
+        from std_msgs.msg import String
+        from std_srvs.srv import Trigger
+        from trajectory_msgs.msg import JointTrajectory
+
+        self.config = config
+        self._lock = threading.Lock()
+        self._odom_arrived = threading.Condition(self._lock)
+        self._odom: Odometry | None = None
+        self._joints: dict[str, float] = {}
+        self._joints_received = 0.0
+        self._objects: ObjectReport | None = None
+        self._objects_received = 0.0
+        self._objects_error = ""
+
+        self._ros = NodeThread(node_name)
+        node = self._ros.node
+        reliable = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
+        self._twist_type = Twist
+        self._pose_type = PoseStamped
+        self._trajectory_type = JointTrajectory
+        self._cmd_vel = node.create_publisher(Twist, config.cmd_vel, reliable)
+        self._goal = node.create_publisher(PoseStamped, config.goal_pose, reliable)
+        self._head = node.create_publisher(JointTrajectory, config.head_trajectory, reliable)
+        self._gripper = node.create_publisher(JointTrajectory, config.gripper_trajectory, reliable)
+        # Best-effort subscriptions match both reliable and best-effort publishers,
+        # which is what real robot drivers use for these streams.
+        node.create_subscription(OdometryMsg, config.odom, self._on_odom, qos_profile_sensor_data)
+        node.create_subscription(JointState, config.joint_states, self._on_joints, qos_profile_sensor_data)
+        node.create_subscription(String, config.objects_topic, self._on_objects,
+                                 QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT))
+        self._perceive = node.create_client(Trigger, config.perceive_service)
+        self._grasp = node.create_client(Trigger, config.grasp_service)
+        self._trigger_request = Trigger.Request
+
+    # -- incoming --------------------------------------------------------------
+
+    def _on_odom(self, msg: object) -> None:
+        pose = msg.pose.pose  # type: ignore[attr-defined]
+        twist = msg.twist.twist  # type: ignore[attr-defined]
+        q = pose.orientation
+        odom = Odometry(
+            pose=Pose(pose.position.x, pose.position.y, yaw_from_quaternion(q.x, q.y, q.z, q.w)),
+            linear=twist.linear.x, angular=twist.angular.z, received=time.monotonic(),
+        )
+        with self._lock:
+            self._odom = odom
+            self._odom_arrived.notify_all()
+
+    def _on_joints(self, msg: object) -> None:
+        names = msg.name  # type: ignore[attr-defined]
+        positions = msg.position  # type: ignore[attr-defined]
+        with self._lock:
+            for name, position in zip(names, positions, strict=False):
+                self._joints[name] = float(position)
+            self._joints_received = time.monotonic()
+
+    def _on_objects(self, msg: object) -> None:
+        try:
+            report = decode_objects(msg.data, f"objects topic {self.config.objects_topic}")  # type: ignore[attr-defined]
+        except FormatError as exc:
+            with self._lock:
+                self._objects_error = str(exc)
+            return
+        with self._lock:
+            self._objects = report
+            self._objects_received = time.monotonic()
+            self._objects_error = ""
+
+    # -- snapshots -------------------------------------------------------------
+
+    def odometry(self) -> Odometry | None:
+        with self._lock:
+            return self._odom
+
+    def wait_for_odometry(self, timeout: float, newer_than: float = 0.0) -> Odometry | None:
+        deadline = time.monotonic() + timeout
+        with self._lock:
+            while self._odom is None or self._odom.received <= newer_than:
+                remaining = deadline - time.monotonic()
+                if remaining <= 0:
+                    return None
+                self._odom_arrived.wait(remaining)
+            return self._odom
+
+    def joints(self) -> tuple[dict[str, float], float]:
+        """Latest joint positions and when they last arrived (0.0: never)."""
+        with self._lock:
+            return dict(self._joints), self._joints_received
+
+    def objects(self) -> tuple[ObjectReport | None, str]:
+        """The latest object report, and the last format error if the newest was malformed."""
+        with self._lock:
+            return self._objects, self._objects_error
+
+    def objects_received(self) -> float:
+        with self._lock:
+            return self._objects_received
+
+    # -- outgoing --------------------------------------------------------------
+
+    def send_twist(self, linear: float, angular: float) -> None:
+        msg = self._twist_type()
+        msg.linear.x = float(linear)
+        msg.angular.z = float(angular)
+        self._cmd_vel.publish(msg)
+
+    def send_zero_twist(self) -> None:
+        # Repeated because a driver that samples cmd_vel best-effort may drop one.
+        for _ in range(3):
+            self.send_twist(0.0, 0.0)
+
+    def send_goal(self, x: float, y: float, heading: float) -> None:
+        msg = self._pose_type()
+        msg.header.frame_id = self.config.world_frame
+        msg.header.stamp = self._ros.node.get_clock().now().to_msg()
+        msg.pose.position.x = float(x)
+        msg.pose.position.y = float(y)
+        qx, qy, qz, qw = quaternion_from_yaw(heading)
+        msg.pose.orientation.x, msg.pose.orientation.y = qx, qy
+        msg.pose.orientation.z, msg.pose.orientation.w = qz, qw
+        self._goal.publish(msg)
+
+    def send_head(self, pan: float, tilt: float, duration: float) -> None:
+        self._send_trajectory(self._head, [self.config.head_pan_joint, self.config.head_tilt_joint],
+                              [pan, tilt], duration)
+
+    def send_gripper(self, position: float, duration: float) -> None:
+        self._send_trajectory(self._gripper, [self.config.gripper_joint], [position], duration)
+
+    def _send_trajectory(self, publisher: object, joints: list[str], positions: list[float],
+                         duration: float) -> None:
+        from builtin_interfaces.msg import Duration
+        from trajectory_msgs.msg import JointTrajectoryPoint
+
+        msg = self._trajectory_type()
+        msg.joint_names = joints
+        point = JointTrajectoryPoint()
+        point.positions = [float(p) for p in positions]
+        seconds = max(duration, 0.0)
+        point.time_from_start = Duration(sec=int(seconds), nanosec=int((seconds % 1.0) * 1e9))
+        msg.points = [point]
+        publisher.publish(msg)  # type: ignore[attr-defined]
+
+    def call_perceive(self, cancel: CancelToken) -> ServiceReply:
+        return self._call(self._perceive, self.config.perceive_service, cancel)
+
+    def call_grasp(self, cancel: CancelToken) -> ServiceReply:
+        return self._call(self._grasp, self.config.grasp_service, cancel)
+
+    def _call(self, client: object, name: str, cancel: CancelToken) -> ServiceReply:
+        timeout = self.config.service_timeout
+        if not client.wait_for_service(timeout_sec=min(timeout, 2.0)):  # type: ignore[attr-defined]
+            raise ServiceError(f"service {name} is not available; is the robot's driver "
+                               "(or `nrtrans sim-bridge`) running and offering it?")
+        future = client.call_async(self._trigger_request())  # type: ignore[attr-defined]
+        answered = threading.Event()
+        future.add_done_callback(lambda _f: answered.set())
+        deadline = time.monotonic() + timeout
+        while not answered.wait(0.02):
+            if cancel.is_set() or time.monotonic() > deadline:
+                client.remove_pending_request(future)  # type: ignore[attr-defined]
+                if cancel.is_set():
+                    raise ServiceError(f"call to {name} abandoned: {cancel.reason}")
+                raise ServiceError(f"service {name} did not answer within {timeout:g} s")
+        response = future.result()
+        return ServiceReply(bool(response.success), str(response.message))
+
+    def listeners(self, publisher: str) -> int:
+        """How many subscriptions match one of our publishers: cmd_vel, goal, head or gripper."""
+        chosen = {"cmd_vel": self._cmd_vel, "goal": self._goal, "head": self._head,
+                  "gripper": self._gripper}[publisher]
+        return int(chosen.get_subscription_count())
+
+    def close(self) -> None:
+        self._ros.close()
+
+
+def distance(a: Pose, x: float, y: float) -> float:
+    return math.hypot(x - a.x, y - a.y)
