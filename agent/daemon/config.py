@@ -93,8 +93,19 @@ class TasksConfig:
 
 @dataclass(frozen=True)
 class TranslatorConfig:
-    model: str = field(default="", metadata=_doc("GGUF model file. Empty: the embedded Gemma 3 270M model."))
-    adapter: str = field(default="", metadata=_doc("LoRA adapter file for the model. Empty: the translator's default."))
+    model: str = field(
+        default="",
+        metadata=_doc(
+            "GGUF model: a file path or a model name from `nrtrans models list`. "
+            "Empty: the embedded Gemma 3 270M model."
+        ),
+    )
+    adapter: str = field(
+        default="",
+        metadata=_doc(
+            "LoRA adapter GGUF file, or `none`. Empty: the adapter shipped for the embedded model, when there is one."
+        ),
+    )
     endpoint: str = field(
         default="",
         metadata=_doc(

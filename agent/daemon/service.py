@@ -14,7 +14,6 @@ import threading
 import time
 from collections import OrderedDict
 from collections.abc import Callable
-from pathlib import Path
 from typing import Any
 
 from agent.daemon.audit import AuditError, AuditLog
@@ -98,6 +97,8 @@ class Service:
             _quietly(self.speech.stop)
         if self.robot is not None:
             _quietly(self.robot.close)
+        if self.translator is not None:
+            _quietly(self.translator.close)
         self.audit.close()
 
     def alive(self) -> bool:
@@ -496,17 +497,6 @@ def _load_profile(path: str) -> Any:
 
 def _load_translator(config: Config, profile: Any) -> Any:
     settings = config.translator
-    if settings.model and not Path(settings.model).expanduser().is_file():
-        raise StartupError(
-            f"the model file {settings.model} does not exist\n"
-            "  = help: fetch it with `nrtrans models fetch`, fix translator.model in the config, "
-            "or leave it empty to use the embedded model"
-        )
-    if settings.adapter and not Path(settings.adapter).expanduser().is_file():
-        raise StartupError(
-            f"the adapter file {settings.adapter} does not exist\n"
-            "  = help: fix translator.adapter in the config, or leave it empty"
-        )
     try:
         from agent.translate import Translator
 
@@ -520,7 +510,9 @@ def _load_translator(config: Config, profile: Any) -> Any:
         )
     except Exception as exc:
         raise StartupError(
-            f"cannot load the translator: {exc}\n  = help: check translator.model and translator.adapter in the config"
+            f"cannot load the translation model: {exc}\n"
+            "  = help: check translator.model and translator.adapter in the config; "
+            "`nrtrans models list` shows the models installed here"
         ) from exc
 
 
