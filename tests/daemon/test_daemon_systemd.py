@@ -1,0 +1,93 @@
+"""The systemd units: `systemd-analyze verify`, and the unit's ExecStart run by hand."""
+
+from __future__ import annotations
+
+import os
+import shlex
+import shutil
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+
+from tests.daemon.conftest import NRTRANS, NotifyListener
+
+UNITS = Path(__file__).resolve().parents[2] / "systemd"
+INSTALLED_BINARY = "/usr/local/bin/nrtrans"
+
+
+def _service_setting(name: str) -> str:
+    for line in (UNITS / "nrtrans.service").read_text().splitlines():
+        if line.startswith(f"{name}="):
+            return line.split("=", 1)[1]
+    raise AssertionError(f"nrtrans.service has no {name}=")
+
+
+def _runnable_copy(directory: Path) -> None:
+    """The units with ExecStart pointing at this checkout's nrtrans, and nothing else changed."""
+    for unit in ("nrtrans.service", "nrtrans.socket"):
+        text = (UNITS / unit).read_text()
+        (directory / unit).write_text(text.replace(INSTALLED_BINARY, NRTRANS))
+
+
+def test_units_pass_systemd_analyze_verify(tmp_path: Path) -> None:
+    analyzer = shutil.which("systemd-analyze")
+    if analyzer is None:
+        pytest.skip("systemd-analyze is not installed (apt-get install systemd); scripts/test.sh installs it")
+    _runnable_copy(tmp_path)
+    result = subprocess.run([analyzer, "verify", str(tmp_path / "nrtrans.service"),
+                             str(tmp_path / "nrtrans.socket")],
+                            capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "nrtrans.service" not in result.stderr, result.stderr
+
+
+def test_unit_declares_what_the_issue_requires() -> None:
+    text = (UNITS / "nrtrans.service").read_text()
+    for line in ("Type=notify", "Restart=on-failure", "NoNewPrivileges=yes", "ProtectSystem=strict",
+                 "ProtectHome=yes", "PrivateTmp=yes", "StateDirectory=nrtrans", "RuntimeDirectory=nrtrans",
+                 "SupplementaryGroups=audio", "User=nrtrans"):
+        assert f"\n{line}\n" in text, line
+    families = _service_setting("RestrictAddressFamilies").split()
+    assert {"AF_UNIX", "AF_INET", "AF_INET6", "AF_NETLINK"} == set(families)
+    assert int(_service_setting("WatchdogSec")) > 0
+
+
+def test_execstart_reports_ready_pings_the_watchdog_and_stops_cleanly(workdir: Path) -> None:
+    command = shlex.split(_service_setting("ExecStart"))
+    assert command[0] == INSTALLED_BINARY
+    command[0] = NRTRANS
+    runtime, state = workdir / "run", workdir / "state"
+    runtime.mkdir()
+    state.mkdir()
+    notify = NotifyListener(workdir / "notify")
+    # What systemd puts in the environment for this unit (WatchdogSec shortened to keep the test quick).
+    env = {**os.environ, "NOTIFY_SOCKET": str(workdir / "notify"), "WATCHDOG_USEC": "1000000",
+           "RUNTIME_DIRECTORY": str(runtime), "STATE_DIRECTORY": str(state)}
+    for key in ("NRTRANS_CONFIG", "WATCHDOG_PID", "LISTEN_FDS", "LISTEN_PID", "NRTRANS_SOCKET"):
+        env.pop(key, None)
+    log = open(workdir / "log", "wb")  # noqa: SIM115
+    started = time.monotonic()
+    process = subprocess.Popen(command, env=env, stdout=log, stderr=subprocess.STDOUT)
+    try:
+        ready = notify.wait_for("READY=1", 180)
+        assert ready is not None, (workdir / "log").read_text()
+        assert (runtime / "nrtrans.sock").exists(), "the socket goes in $RUNTIME_DIRECTORY"
+        assert oct((runtime / "nrtrans.sock").stat().st_mode & 0o777) == "0o660"
+        second_ping = notify.wait_for("WATCHDOG=1", 10, count=2)
+        assert second_ping is not None and second_ping > ready, "WATCHDOG=1 pings after READY=1"
+        assert any(line.startswith("STATUS=") for line in notify.lines())
+        process.send_signal(signal.SIGTERM)
+        assert process.wait(60) == 0, (workdir / "log").read_text()
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+        notify.close()
+        log.close()
+    assert "STOPPING=1" in notify.lines()
+    assert not (runtime / "nrtrans.sock").exists(), "the socket file is removed on a clean stop"
+    assert (state / "audit.jsonl").exists(), "the audit log goes in $STATE_DIRECTORY"
+    print(f"start to READY=1: {ready - started:.2f} s")
