@@ -180,7 +180,15 @@ EVENT_FIELDS: dict[str, tuple[str, dict[str, Any]]] = {
             "rsl": {"type": ["string", "null"]},
         },
     ),
-    "heard": ("Speech input produced a transcript.", {"text": {"type": "string"}}),
+    "heard": (
+        "Speech input produced a transcript; the task it starts follows.",
+        {
+            "text": {"type": "string"},
+            "source": {"type": "string"},
+            "started_at": {"type": "number"},
+            "ended_at": {"type": "number"},
+        },
+    ),
     "translating": ("The model is writing a program for the task.", {"text": {"type": "string"}}),
     "attempt": (
         "One program written by the model (or submitted) and its diagnostics.",

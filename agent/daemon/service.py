@@ -256,7 +256,10 @@ class Service:
                 f"speech input is not running: {self.speech_problem}",
                 "see `nrtrans health`; submit text with `nrtrans send` meanwhile",
             )
-        self.speech.listen_now()
+        try:
+            self.speech.listen_now()
+        except RuntimeError as exc:
+            raise ProtocolError("unavailable", str(exc), "see `nrtrans health` for the audio device and model") from exc
 
     def idle_status(self) -> str:
         return f"ready: {self.config.robot.backend} backend, listening on {self.config.socket_path()}"
@@ -285,6 +288,9 @@ class Service:
             finally:
                 with self._lock:
                     self._current = None
+            if self.speech is not None:
+                # `perceive` may have found objects; let speech recognition expect their names.
+                _quietly(lambda: self.speech.set_objects(self._known_objects()))
             self.on_status(
                 self.idle_status()
                 if self._estop_reason is None
@@ -369,6 +375,9 @@ class Service:
             if step.outcome is None:
                 if "first_command_ms" not in task.timings_ms:
                     task.mark("first_command_ms", start)
+                    if task.transcript and "ended_at" in task.transcript:
+                        ended = float(task.transcript["ended_at"])
+                        task.timings_ms["speech_end_to_first_command_ms"] = round((time.time() - ended) * 1000, 3)
                 self.events.publish("executing", task.id, step=number, total=step.total, statement=step.statement)
                 return
             outcome = {"status": step.outcome.status.value, "reason": step.outcome.reason}
@@ -446,7 +455,9 @@ class Service:
         try:
             from agent.daemon.voice import start_speech
 
-            self.speech = start_speech(self.config.speech.options, self._on_transcript, self._on_speech_event)
+            self.speech = start_speech(
+                self.config.speech.options, self.config.robot.profile, self._on_transcript, self._on_speech_event
+            )
         except Exception as exc:
             self.speech = None
             self.speech_problem = f"{type(exc).__name__}: {exc}"
@@ -456,20 +467,21 @@ class Service:
         text = str(transcript.text).strip()
         if not text:
             return
+        heard = transcript.to_dict() if hasattr(transcript, "to_dict") else {"text": text}
+
+        def announce(task: Task) -> None:
+            task.transcript = heard
+            self.events.publish("heard", task.id, **heard)
+
         try:
-
-            def announce(task: Task) -> None:
-                self.events.publish("heard", task.id, text=text)
-
             self.submit(source="voice", text=text[: self.config.api.max_task_chars], before_queue=announce)
         except ProtocolError as exc:
             log.warning("spoken task %r not queued: %s", text, exc.message)
             self.events.publish("speech", None, state="dropped", detail={"text": text, "reason": exc.message})
 
     def _on_speech_event(self, event: Any) -> None:
-        name = getattr(event, "name", None) or getattr(event, "kind", None) or str(event)
         detail = event.to_dict() if hasattr(event, "to_dict") else {}
-        self.events.publish("speech", None, state=str(name), detail=detail)
+        self.events.publish("speech", None, state=str(getattr(event, "kind", event)), detail=detail)
 
 
 def _last_reason(result: Any) -> str:

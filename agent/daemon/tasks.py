@@ -55,6 +55,7 @@ class Task:
     text: str | None = None
     rsl: str | None = None
     peer: Peer | None = None
+    transcript: dict[str, Any] | None = None
     id: str = field(default_factory=lambda: uuid.uuid4().hex[:12])
     created: float = field(default_factory=time.time)
     state: TaskState = TaskState.QUEUED
@@ -75,6 +76,7 @@ class Task:
             "source": self.source,
             "peer": self.peer.to_dict() if self.peer else None,
             "created": self.created,
+            "transcript": self.transcript,
             "text": self.text,
             "rsl": self.rsl,
             "attempts": list(self.attempts),

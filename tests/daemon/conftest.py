@@ -22,8 +22,11 @@ from agent.client import Client
 from agent.daemon.schemas import ERROR, EVENT, REPLY
 
 NRTRANS = str(Path(sys.executable).with_name("nrtrans"))
-VALIDATORS = {"reply": Draft202012Validator(REPLY), "error": Draft202012Validator(ERROR),
-              "event": Draft202012Validator(EVENT)}
+VALIDATORS = {
+    "reply": Draft202012Validator(REPLY),
+    "error": Draft202012Validator(ERROR),
+    "event": Draft202012Validator(EVENT),
+}
 
 
 def check_frame(frame: dict[str, Any]) -> dict[str, Any]:
@@ -95,16 +98,23 @@ def _toml(value: Any) -> str:
 class Daemon:
     """`nrtrans serve` in a subprocess; `settings` are config sections, e.g. {"tasks": {"queue_size": 2}}."""
 
-    def __init__(self, workdir: Path, settings: dict[str, dict[str, Any]] | None = None, *,
-                 extra_env: dict[str, str] | None = None) -> None:
+    def __init__(
+        self,
+        workdir: Path,
+        settings: dict[str, dict[str, Any]] | None = None,
+        *,
+        extra_env: dict[str, str] | None = None,
+    ) -> None:
         self.workdir = workdir
         self.socket = workdir / "api.sock"
         self.state_dir = workdir / "state"
         self.config_file = workdir / "config.toml"
         self.log = workdir / "daemon.log"
         sections: dict[str, dict[str, Any]] = {
-            "api": {"socket": str(self.socket)}, "robot": {"realtime_factor": 1.0},
-            "speech": {"enabled": False}}
+            "api": {"socket": str(self.socket)},
+            "robot": {"realtime_factor": 1.0},
+            "speech": {"enabled": False},
+        }
         for name, values in (settings or {}).items():
             sections.setdefault(name, {}).update(values)
         text = f"state_dir = {_toml(str(self.state_dir))}\n"
@@ -123,8 +133,9 @@ class Daemon:
         env.pop("NRTRANS_CONFIG", None)
         self.started_at = time.monotonic()
         with open(self.log, "ab") as log:
-            self.process = subprocess.Popen([NRTRANS, "serve", "--config", str(self.config_file)],
-                                            stdout=log, stderr=subprocess.STDOUT, env=env)
+            self.process = subprocess.Popen(
+                [NRTRANS, "serve", "--config", str(self.config_file)], stdout=log, stderr=subprocess.STDOUT, env=env
+            )
         if wait_ready:
             deadline = time.monotonic() + timeout
             while self.notify.wait_for("READY=1", 0.5) is None:

@@ -21,7 +21,10 @@ def test_each_change_is_a_full_snapshot_and_the_last_is_final(tmp_path: Path) ->
     log.close()
     lines = _lines(tmp_path / "audit.jsonl")
     assert [(r["rev"], r["state"], r["final"]) for r in lines] == [
-        (1, "queued", False), (2, "executing", False), (3, "done", True)]
+        (1, "queued", False),
+        (2, "executing", False),
+        (3, "done", True),
+    ]
     assert AuditLog(tmp_path / "audit.jsonl").recent(5)[0]["state"] == "done"
 
 

@@ -13,7 +13,8 @@ ROOT = Path(__file__).resolve().parents[2]
 
 def test_docs_config_md_is_generated_from_the_dataclasses() -> None:
     assert (ROOT / "docs" / "config.md").read_text(encoding="utf-8") == render_markdown(), (
-        "docs/config.md is stale: run `nrtrans serve --config-doc > docs/config.md`")
+        "docs/config.md is stale: run `nrtrans serve --config-doc > docs/config.md`"
+    )
 
 
 def test_printed_config_reads_back_as_the_defaults(tmp_path: Path) -> None:
@@ -25,7 +26,8 @@ def test_printed_config_reads_back_as_the_defaults(tmp_path: Path) -> None:
 def test_settings_are_read_and_typed() -> None:
     config = parse_config(
         'state_dir = "/tmp/s"\n[api]\nmax_line_bytes = 4096\nallowed_uids = [1000]\n'
-        '[robot]\nbackend = "ros2"\nrealtime_factor = 2\n[speech.options]\ndevice = "hw:1"\n')
+        '[robot]\nbackend = "ros2"\nrealtime_factor = 2\n[speech.options]\ndevice = "hw:1"\n'
+    )
     assert config.state_path() == Path("/tmp/s")
     assert config.api.max_line_bytes == 4096
     assert config.api.allowed_uids == (1000,)
@@ -34,15 +36,18 @@ def test_settings_are_read_and_typed() -> None:
     assert config.speech.options == {"device": "hw:1"}
 
 
-@pytest.mark.parametrize(("text", "expected"), [
-    ("[api]\nmax_line_bytes = \"big\"\n", "api.max_line_bytes must be a whole number"),
-    ("[api]\nmax_lines = 3\n", "unknown setting api.max_lines"),
-    ("[robot]\nbackend = \"gazebo\"\n", "robot.backend = 'gazebo' is not one of"),
-    ("[tasks]\nqueue_size = 0\n", "tasks.queue_size = 0 is below the minimum 1"),
-    ("[api]\nsocket_mode = \"rw\"\n", "octal"),
-    ("api = 3\n", "api must be a table"),
-    ("[api\n", "not valid TOML"),
-])
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        ('[api]\nmax_line_bytes = "big"\n', "api.max_line_bytes must be a whole number"),
+        ("[api]\nmax_lines = 3\n", "unknown setting api.max_lines"),
+        ('[robot]\nbackend = "gazebo"\n', "robot.backend = 'gazebo' is not one of"),
+        ("[tasks]\nqueue_size = 0\n", "tasks.queue_size = 0 is below the minimum 1"),
+        ('[api]\nsocket_mode = "rw"\n', "octal"),
+        ("api = 3\n", "api must be a table"),
+        ("[api\n", "not valid TOML"),
+    ],
+)
 def test_bad_settings_are_errors_that_say_where(text: str, expected: str) -> None:
     with pytest.raises(ConfigError) as caught:
         parse_config(text, source="my.toml")
@@ -57,7 +62,8 @@ def test_missing_config_file_says_what_to_do(tmp_path: Path) -> None:
 
 def test_flags_override_the_file() -> None:
     config = parse_config('[api]\nsocket = "/a.sock"\n').with_overrides(
-        socket="/b.sock", state_dir="/st", backend="ros2")
+        socket="/b.sock", state_dir="/st", backend="ros2"
+    )
     assert config.socket_path() == Path("/b.sock")
     assert config.audit_path() == Path("/st/audit.jsonl")
     assert config.robot.backend == "ros2"

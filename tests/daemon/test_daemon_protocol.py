@@ -22,11 +22,19 @@ json_values = st.recursive(
 )
 request_like = st.fixed_dictionaries(
     {},
-    optional={"v": st.sampled_from([1, 2, "1", None, True]),
-              "op": st.sampled_from([*REQUESTS, "exec", "", 7]),
-              "id": json_values, "text": json_values, "rsl": json_values, "task": json_values,
-              "follow": json_values, "limit": json_values, "reason": json_values,
-              "extra": json_values})
+    optional={
+        "v": st.sampled_from([1, 2, "1", None, True]),
+        "op": st.sampled_from([*REQUESTS, "exec", "", 7]),
+        "id": json_values,
+        "text": json_values,
+        "rsl": json_values,
+        "task": json_values,
+        "follow": json_values,
+        "limit": json_values,
+        "reason": json_values,
+        "extra": json_values,
+    },
+)
 
 
 def _check(decoded: Request | ProtocolError) -> None:
@@ -53,20 +61,30 @@ def test_request_shaped_objects_are_accepted_only_when_valid(body: dict) -> None
 
 
 def test_well_formed_requests_decode() -> None:
-    for line in ('{"v":1,"op":"submit","text":"go forward"}', '{"v":1,"op":"submit","rsl":"forward 1;"}',
-                 '{"v":1,"op":"status"}', '{"v":1,"op":"cancel","task":"abc123"}',
-                 '{"v":1,"op":"history","limit":5,"id":"x"}', '{"v":1,"op":"estop","reason":"test"}'):
+    for line in (
+        '{"v":1,"op":"submit","text":"go forward"}',
+        '{"v":1,"op":"submit","rsl":"forward 1;"}',
+        '{"v":1,"op":"status"}',
+        '{"v":1,"op":"cancel","task":"abc123"}',
+        '{"v":1,"op":"history","limit":5,"id":"x"}',
+        '{"v":1,"op":"estop","reason":"test"}',
+    ):
         assert isinstance(decode_request(line.encode(), max_task_chars=100), Request), line
 
 
 def test_bad_requests_get_the_right_code() -> None:
-    cases = {b"not json": "bad_json", b"[]": "bad_json", b'\xff{"v":1}': "bad_json",
-             b'{"op":"health"}': "bad_version", b'{"v":2,"op":"health"}': "bad_version",
-             b'{"v":1,"op":"exec","cmd":"rm -rf /"}': "unknown_op",
-             b'{"v":1,"op":"submit","text":"a","rsl":"b"}': "bad_request",
-             b'{"v":1,"op":"submit","text":"go","path":"/etc/passwd"}': "bad_request",
-             b'{"v":1,"op":"cancel","task":"../../x"}': "bad_request",
-             b'{"v":1,"op":"submit","text":"' + b"a" * 101 + b'"}': "too_long"}
+    cases = {
+        b"not json": "bad_json",
+        b"[]": "bad_json",
+        b'\xff{"v":1}': "bad_json",
+        b'{"op":"health"}': "bad_version",
+        b'{"v":2,"op":"health"}': "bad_version",
+        b'{"v":1,"op":"exec","cmd":"rm -rf /"}': "unknown_op",
+        b'{"v":1,"op":"submit","text":"a","rsl":"b"}': "bad_request",
+        b'{"v":1,"op":"submit","text":"go","path":"/etc/passwd"}': "bad_request",
+        b'{"v":1,"op":"cancel","task":"../../x"}': "bad_request",
+        b'{"v":1,"op":"submit","text":"' + b"a" * 101 + b'"}': "too_long",
+    }
     for line, code in cases.items():
         decoded = decode_request(line, max_task_chars=100)
         assert isinstance(decoded, ProtocolError) and decoded.code == code, (line, decoded)
@@ -82,5 +100,6 @@ def test_schemas_are_valid_and_documented() -> None:
         Draft202012Validator.check_schema(schema)
     api_md = (ROOT / "docs" / "api.md").read_text(encoding="utf-8")
     assert api_md.endswith(render_markdown()), (
-        "docs/api.md is stale: replace its schema part with `nrtrans serve --api-doc`")
+        "docs/api.md is stale: replace its schema part with `nrtrans serve --api-doc`"
+    )
     assert json.dumps(REQUESTS["submit"], indent=2) in api_md

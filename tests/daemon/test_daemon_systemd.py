@@ -37,18 +37,30 @@ def test_units_pass_systemd_analyze_verify(tmp_path: Path) -> None:
     if analyzer is None:
         pytest.skip("systemd-analyze is not installed (apt-get install systemd); scripts/test.sh installs it")
     _runnable_copy(tmp_path)
-    result = subprocess.run([analyzer, "verify", str(tmp_path / "nrtrans.service"),
-                             str(tmp_path / "nrtrans.socket")],
-                            capture_output=True, text=True, timeout=120)
+    result = subprocess.run(
+        [analyzer, "verify", str(tmp_path / "nrtrans.service"), str(tmp_path / "nrtrans.socket")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert result.returncode == 0, result.stdout + result.stderr
     assert "nrtrans.service" not in result.stderr, result.stderr
 
 
 def test_unit_declares_what_the_issue_requires() -> None:
     text = (UNITS / "nrtrans.service").read_text()
-    for line in ("Type=notify", "Restart=on-failure", "NoNewPrivileges=yes", "ProtectSystem=strict",
-                 "ProtectHome=yes", "PrivateTmp=yes", "StateDirectory=nrtrans", "RuntimeDirectory=nrtrans",
-                 "SupplementaryGroups=audio", "User=nrtrans"):
+    for line in (
+        "Type=notify",
+        "Restart=on-failure",
+        "NoNewPrivileges=yes",
+        "ProtectSystem=strict",
+        "ProtectHome=yes",
+        "PrivateTmp=yes",
+        "StateDirectory=nrtrans",
+        "RuntimeDirectory=nrtrans",
+        "SupplementaryGroups=audio",
+        "User=nrtrans",
+    ):
         assert f"\n{line}\n" in text, line
     families = _service_setting("RestrictAddressFamilies").split()
     assert {"AF_UNIX", "AF_INET", "AF_INET6", "AF_NETLINK"} == set(families)
@@ -64,8 +76,13 @@ def test_execstart_reports_ready_pings_the_watchdog_and_stops_cleanly(workdir: P
     state.mkdir()
     notify = NotifyListener(workdir / "notify")
     # What systemd puts in the environment for this unit (WatchdogSec shortened to keep the test quick).
-    env = {**os.environ, "NOTIFY_SOCKET": str(workdir / "notify"), "WATCHDOG_USEC": "1000000",
-           "RUNTIME_DIRECTORY": str(runtime), "STATE_DIRECTORY": str(state)}
+    env = {
+        **os.environ,
+        "NOTIFY_SOCKET": str(workdir / "notify"),
+        "WATCHDOG_USEC": "1000000",
+        "RUNTIME_DIRECTORY": str(runtime),
+        "STATE_DIRECTORY": str(state),
+    }
     for key in ("NRTRANS_CONFIG", "WATCHDOG_PID", "LISTEN_FDS", "LISTEN_PID", "NRTRANS_SOCKET"):
         env.pop(key, None)
     log = open(workdir / "log", "wb")  # noqa: SIM115
