@@ -70,12 +70,10 @@ class Daemon:
         notify.settimeout(300)
         env = {**os.environ, "NOTIFY_SOCKET": str(notify_path)}
         started = time.monotonic()
-        self.process = subprocess.Popen(
-            [NRTRANS, "serve", "--config", str(self.config)],
-            env=env,
-            stdout=subprocess.DEVNULL,
-            stderr=open(self.workdir / "log", "ab"),
-        )  # noqa: SIM115
+        with open(self.workdir / "log", "ab") as log:
+            self.process = subprocess.Popen(
+                [NRTRANS, "serve", "--config", str(self.config)], env=env, stdout=subprocess.DEVNULL, stderr=log
+            )
         try:
             while b"READY=1" not in notify.recv(65536).split(b"\n"):
                 pass
@@ -153,8 +151,7 @@ def bench_estop(daemon: Daemon, count: int) -> list[float]:
             sent = time.perf_counter()
             operator.estop("benchmark")
             times.append((time.perf_counter() - sent) * 1000)
-            for event in client.follow(task):
-                pass
+            list(client.follow(task))
             operator.reset()
             client.submit(rsl="backward 0.3;", follow=True)
             for event in client.events():
