@@ -341,7 +341,7 @@ def _rows(cls: type, prefix: str) -> list[tuple[str, str, Any, str]]:
         hint = hints[f.name]
         if dataclasses.is_dataclass(hint):
             continue
-        default = f.default_factory() if f.default is dataclasses.MISSING else f.default  # type: ignore[misc]
+        default = f.default_factory() if f.default_factory is not dataclasses.MISSING else f.default
         rows.append((prefix + f.name, _toml_value(default), hint, f.metadata["doc"]))
     return rows
 

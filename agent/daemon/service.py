@@ -359,11 +359,12 @@ class Service:
         assert task.rsl is not None
         result = compile_program(task.rsl, self.profile, known)
         task.mark("compile_ms", start)
-        entry = {"pass": 1, "program": task.rsl, "diagnostics": [d.to_dict() for d in result.diagnostics]}
+        diagnostics = [d.to_dict() for d in result.diagnostics]
+        entry = {"pass": 1, "program": task.rsl, "diagnostics": diagnostics}
         task.attempts.append(entry)
         self.events.publish("attempt", task.id, **entry)
         if not result.ok:
-            self._reject(task, "the program does not compile; nothing moved", entry["diagnostics"])
+            self._reject(task, "the program does not compile; nothing moved", diagnostics)
             return None
         return result.plan
 
