@@ -1,0 +1,45 @@
+"""End of speech by silence, from the loudness of each audio block.
+
+Vosk has its own endpointing, but its trailing-silence rules come from the
+model's config and cannot be set per robot; this detector makes
+`silence_ms` mean what it says on any model and any microphone.
+"""
+
+from __future__ import annotations
+
+from agent.speech.audio import rms
+
+# Below this RMS (of 32768) nothing counts as speech, however quiet the room.
+MIN_SPEECH_RMS = 300.0
+# Speech must be this many times louder than the running noise floor.
+FLOOR_FACTOR = 3.0
+
+
+class SilenceDetector:
+    def __init__(self, rate: int, silence_ms: int) -> None:
+        self.rate = rate
+        self.silence_samples = rate * silence_ms // 1000
+        self.floor: float | None = None
+        self.heard_speech = False
+        self.quiet_samples = 0
+        self.samples = 0
+
+    def feed(self, block: bytes) -> bool:
+        """Add a block of int16 samples; True once speech was heard and then `silence_ms` of quiet."""
+        level = rms(block)
+        count = len(block) // 2
+        self.samples += count
+        threshold = max(MIN_SPEECH_RMS, (self.floor or 0.0) * FLOOR_FACTOR)
+        if level > threshold:
+            self.heard_speech = True
+            self.quiet_samples = 0
+        else:
+            self.quiet_samples += count
+            # The floor follows the room slowly, so a fan or a hum raises the
+            # bar for speech without a single loud block doing so.
+            self.floor = level if self.floor is None else 0.95 * self.floor + 0.05 * level
+        return self.heard_speech and self.quiet_samples >= self.silence_samples
+
+    @property
+    def seconds(self) -> float:
+        return self.samples / self.rate

@@ -1,0 +1,395 @@
+"""Live speech input: microphone -> wake word or push-to-talk -> Vosk -> transcript.
+
+One worker thread owns the audio stream and the recognisers, so Vosk is never
+used from two threads. PortAudio's callback only queues raw blocks. Nothing
+here may take the daemon down: a missing model or microphone, a device that
+disappears, or a callback that raises is logged, reported in `health()` and
+retried, while the rest of the daemon keeps serving.
+"""
+
+from __future__ import annotations
+
+import logging
+import queue
+import threading
+import time
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from agent.speech.endpoint import SilenceDetector
+from agent.speech.lexicon import lexicon_for
+from agent.speech.recognizer import LoadedModel, load_model, result_text
+from agent.speech.records import SpeechConfig, SpeechEvent, Transcript, TranscriptSource
+from agent.speech.vocabulary import UNKNOWN, Vocabulary
+
+log = logging.getLogger("nrtrans.speech")
+
+# Audio kept before a wake word is confirmed, so the task said in the same
+# breath ("robot, go forward") is not lost.
+PREROLL_S = 6.0
+# No block for this long from a running stream means the device is gone.
+STALL_S = 3.0
+QUEUE_BLOCKS = 300
+
+
+class SpeechUnavailable(RuntimeError):
+    """Push-to-talk asked for while the speech input cannot listen; says why."""
+
+
+@dataclass
+class _Utterance:
+    source: TranscriptSource
+    started_at: float
+    detector: SilenceDetector
+    # After a lone wake word the task comes in a second utterance.
+    follow_up: bool = False
+
+
+class SpeechInput:
+    def __init__(self, config: SpeechConfig, on_transcript: Callable[[Transcript], None],
+                 on_event: Callable[[SpeechEvent], None] | None = None) -> None:
+        self.config = config
+        self._on_transcript = on_transcript
+        self._on_event = on_event
+        self._lock = threading.Lock()
+        self._stopping = threading.Event()
+        self._push_to_talk = threading.Event()
+        self._objects_changed = threading.Event()
+        self._objects: tuple[str, ...] = tuple(config.objects)
+        self._thread: threading.Thread | None = None
+        self._blocks: queue.Queue[bytes] = queue.Queue(maxsize=QUEUE_BLOCKS)
+        self._state = "stopped" if config.enabled else "disabled"
+        self._model_info: dict[str, Any] = {"loaded": False, "path": None, "runtime_grammar": False,
+                                            "error": None}
+        self._device_info: dict[str, Any] = {"present": False, "name": None, "sample_rate": None,
+                                             "error": None}
+        self._vocabulary_size = 0
+        self._dropped = 0
+        self._transcripts = 0
+        self._model: LoadedModel | None = None
+        self._wake_words = tuple(w.lower() for w in config.wake_words)
+
+    # -- the public interface -------------------------------------------------------------
+
+    def start(self) -> None:
+        """Start listening in the background; never raises for a missing model or microphone."""
+        if not self.config.enabled or self._thread is not None:
+            return
+        self._stopping.clear()
+        self._set_state("starting")
+        self._thread = threading.Thread(target=self._run, name="nrtrans-speech", daemon=True)
+        self._thread.start()
+
+    def stop(self, timeout: float = 5.0) -> None:
+        self._stopping.set()
+        thread, self._thread = self._thread, None
+        if thread is not None:
+            thread.join(timeout)
+        if self.config.enabled:
+            self._set_state("stopped")
+
+    def listen_now(self) -> None:
+        """Push-to-talk: take the next utterance without a wake word."""
+        with self._lock:
+            state = self._state
+            problem = self._model_info["error"] or self._device_info["error"]
+        if state not in ("waiting_for_wake_word", "push_to_talk_only", "listening"):
+            raise SpeechUnavailable(f"speech input cannot listen now ({state}"
+                                    f"{': ' + problem if problem else ''}); see `nrtrans health`")
+        self._push_to_talk.set()
+
+    def set_objects(self, names: tuple[str, ...] | list[str]) -> None:
+        """Bias toward these object names from the next utterance on (e.g. after `perceive`)."""
+        with self._lock:
+            self._objects = tuple(dict.fromkeys([*self.config.objects, *names]))
+        self._objects_changed.set()
+
+    def health(self) -> dict[str, Any]:
+        with self._lock:
+            listening = self._state in ("waiting_for_wake_word", "push_to_talk_only", "listening")
+            return {
+                "ok": self.config.enabled and listening,
+                "enabled": self.config.enabled,
+                "state": self._state,
+                "listening": listening,
+                "model": dict(self._model_info),
+                "audio_device": dict(self._device_info),
+                "grammar_bias": self.config.grammar_bias and bool(self._model_info["runtime_grammar"]),
+                "vocabulary_size": self._vocabulary_size,
+                "wake_words": list(self._wake_words),
+                "dropped_blocks": self._dropped,
+                "transcripts": self._transcripts,
+            }
+
+    # -- the worker -----------------------------------------------------------------------
+
+    def _run(self) -> None:
+        try:
+            self._model = self._load()
+        except Exception as exc:
+            message = str(exc)
+            with self._lock:
+                self._model_info.update(loaded=False, error=message)
+            self._set_state("no_model")
+            self._emit("model_error", reason=message)
+            log.warning("speech input has no model: %s", message)
+            self._probe_device()
+            return
+        reported = ""
+        while not self._stopping.is_set():
+            try:
+                stream, rate = self._open_stream()
+            except Exception as exc:
+                message = str(exc) or type(exc).__name__
+                with self._lock:
+                    self._device_info.update(present=False, error=message)
+                self._set_state("no_device")
+                if message != reported:
+                    reported = message
+                    self._emit("device_error", reason=message)
+                    log.warning("speech input has no audio device: %s; retrying every %.0f s",
+                                message, self.config.retry_s)
+                self._stopping.wait(self.config.retry_s)
+                continue
+            reported = ""
+            try:
+                self._listen(stream, rate)
+            except _DeviceLost as exc:
+                with self._lock:
+                    self._device_info.update(present=False, error=str(exc))
+                self._set_state("no_device")
+                self._emit("device_lost", reason=str(exc))
+                log.warning("audio device lost: %s", exc)
+            except Exception as exc:
+                log.exception("speech input failed; restarting it")
+                self._emit("device_error", reason=f"{type(exc).__name__}: {exc}")
+                self._stopping.wait(self.config.retry_s)
+            finally:
+                _close(stream)
+        self._emit("stopped")
+
+    def _load(self) -> LoadedModel:
+        from models.store import resolve_vosk
+
+        lexicon_for(self.config.language)
+        path = resolve_vosk(self.config.model)
+        with self._lock:
+            self._model_info.update(path=str(path))
+        model = load_model(path)
+        with self._lock:
+            self._model_info.update(loaded=True, runtime_grammar=model.runtime_grammar, error=None)
+        return model
+
+    def _vocabulary(self, model: LoadedModel) -> Vocabulary:
+        from rsl.profile import load_profile
+
+        with self._lock:
+            objects = self._objects
+        vocabulary = model.vocabulary(load_profile(self.config.profile), self.config.language, objects,
+                                      self._wake_words)
+        with self._lock:
+            self._vocabulary_size = len(vocabulary)
+        return vocabulary
+
+    def _probe_device(self) -> None:
+        """Fill in the device half of `health` even when there is no model to listen with."""
+        try:
+            import sounddevice as sd
+
+            info = sd.query_devices(self.config.device, "input")
+            with self._lock:
+                self._device_info.update(present=True, name=info["name"], error=None)
+        except Exception as exc:
+            with self._lock:
+                self._device_info.update(present=False, error=_device_message(exc, self.config.device))
+
+    def _open_stream(self) -> tuple[Any, int]:
+        try:
+            import sounddevice as sd
+        except OSError as exc:
+            raise RuntimeError(f"PortAudio is not installed ({exc}); install libportaudio2") from None
+        device = self.config.device
+        try:
+            info = sd.query_devices(device, "input")
+        except Exception as exc:
+            raise RuntimeError(_device_message(exc, device)) from None
+        rate = self.config.sample_rate
+        try:
+            sd.check_input_settings(device=device, samplerate=rate, channels=1, dtype="int16")
+        except Exception:
+            # Vosk takes any rate, so use what the device offers rather than fail.
+            rate = int(info["default_samplerate"])
+        self._blocks = queue.Queue(maxsize=QUEUE_BLOCKS)
+        blocks = self._blocks
+
+        def on_audio(data: Any, frames: int, when: Any, status: Any) -> None:
+            try:
+                blocks.put_nowait(bytes(data))
+            except queue.Full:
+                with self._lock:
+                    self._dropped += 1
+
+        stream = sd.RawInputStream(device=device, samplerate=rate, channels=1, dtype="int16",
+                                   blocksize=rate // 10, callback=on_audio)
+        try:
+            stream.start()
+        except Exception:
+            _close(stream)
+            raise
+        with self._lock:
+            self._device_info.update(present=True, name=info["name"], sample_rate=rate, error=None)
+        return stream, rate
+
+    def _listen(self, stream: Any, rate: int) -> None:
+        assert self._model is not None
+        model = self._model
+        vocabulary = self._vocabulary(model)
+        bias = self.config.grammar_bias and model.runtime_grammar
+        utterance_recognizer = model.recognizer(rate, vocabulary.grammar() if bias else None)
+        wake_recognizer = model.recognizer(rate, self._wake_grammar(vocabulary)) if self._wake_words else None
+        preroll: deque[bytes] = deque(maxlen=int(PREROLL_S * 10) + 1)
+        utterance: _Utterance | None = None
+        idle_state = "waiting_for_wake_word" if wake_recognizer is not None else "push_to_talk_only"
+        self._set_state(idle_state)
+        self._emit("ready", device=self._device_info["name"], sample_rate=rate,
+                   vocabulary_size=len(vocabulary) if bias else 0)
+        last_block = time.monotonic()
+        while not self._stopping.is_set():
+            try:
+                block = self._blocks.get(timeout=0.5)
+            except queue.Empty:
+                if time.monotonic() - last_block > STALL_S or not stream.active:
+                    raise _DeviceLost("the audio device stopped delivering sound") from None
+                continue
+            last_block = time.monotonic()
+            if utterance is None and self._objects_changed.is_set():
+                self._objects_changed.clear()
+                vocabulary = self._vocabulary(model)
+                utterance_recognizer = model.recognizer(rate, vocabulary.grammar() if bias else None)
+            if utterance is None and self._push_to_talk.is_set():
+                self._push_to_talk.clear()
+                utterance = self._begin(utterance_recognizer, rate, "push_to_talk", [])
+            if utterance is None:
+                preroll.append(block)
+                if wake_recognizer is None:
+                    continue
+                heard, segment_over = self._heard_wake_word(wake_recognizer, block)
+                if heard:
+                    wake_recognizer.Reset()
+                    self._emit("wake")
+                    utterance = self._begin(utterance_recognizer, rate, "wake_word", list(preroll))
+                    preroll.clear()
+                elif segment_over:
+                    # Keep the pre-roll to the current stretch of speech, so
+                    # an earlier sentence is not glued to the task.
+                    preroll.clear()
+                continue
+            utterance = self._continue(utterance, utterance_recognizer, block, rate)
+            if utterance is None:
+                self._set_state(idle_state)
+
+    def _wake_grammar(self, vocabulary: Vocabulary) -> str:
+        import json
+
+        # Without [unk] a closed grammar would hear the wake word in every
+        # sound; the other task words give non-wake speech somewhere to go.
+        others = [UNKNOWN] if vocabulary.has_unknown else [w for w in vocabulary.words
+                                                             if w not in self._wake_words]
+        return json.dumps([*self._wake_words, *others], ensure_ascii=False)
+
+    def _heard_wake_word(self, recognizer: Any, block: bytes) -> tuple[bool, bool]:
+        """(wake word heard, Vosk closed the segment)."""
+        segment_over = bool(recognizer.AcceptWaveform(block))
+        text = result_text(recognizer.Result() if segment_over else recognizer.PartialResult())
+        padded = f" {text} "
+        return any(f" {wake} " in padded for wake in self._wake_words), segment_over
+
+    def _begin(self, recognizer: Any, rate: int, source: TranscriptSource, preroll: list[bytes],
+               follow_up: bool = False) -> _Utterance:
+        recognizer.Reset()
+        detector = SilenceDetector(rate, self.config.silence_ms)
+        seconds = sum(len(b) for b in preroll) / 2 / rate
+        utterance = _Utterance(source, time.time() - seconds, detector, follow_up)
+        for block in preroll:
+            recognizer.AcceptWaveform(block)
+            detector.feed(block)
+        self._set_state("listening")
+        self._emit("listening", source=source)
+        return utterance
+
+    def _continue(self, utterance: _Utterance, recognizer: Any, block: bytes, rate: int) -> _Utterance | None:
+        """Feed one block; returns the utterance still in progress, or None when it is over."""
+        endpoint = recognizer.AcceptWaveform(block)
+        silent = utterance.detector.feed(block)
+        detector = utterance.detector
+        if not detector.heard_speech and detector.seconds >= self.config.no_speech_timeout_s:
+            recognizer.Reset()
+            self._emit("no_speech", source=utterance.source)
+            return None
+        if endpoint and not detector.heard_speech:
+            # Vosk closes a segment on its own silence rules; before any speech
+            # that is just the room, so keep waiting.
+            return utterance
+        if not (endpoint or silent or detector.seconds >= self.config.max_utterance_s):
+            return utterance
+        text = result_text(recognizer.Result() if endpoint else recognizer.FinalResult())
+        recognizer.Reset()
+        text = self._strip_wake_word(text)
+        if not text:
+            if utterance.source == "wake_word" and not utterance.follow_up:
+                # "Robot." ... "go forward": the task comes next.
+                return self._begin(recognizer, rate, "wake_word", [], follow_up=True)
+            self._emit("empty", source=utterance.source)
+            return None
+        transcript = Transcript(text, utterance.started_at, time.time(), utterance.source)
+        with self._lock:
+            self._transcripts += 1
+        self._emit("heard", text=text, source=utterance.source)
+        try:
+            self._on_transcript(transcript)
+        except Exception:
+            log.exception("the transcript handler failed for %r", text)
+        return None
+
+    def _strip_wake_word(self, text: str) -> str:
+        """The words after the first wake word; all of them when there is none."""
+        padded = f" {text} "
+        cut = [padded.find(f" {wake} ") + len(wake) + 1 for wake in self._wake_words if f" {wake} " in padded]
+        return padded[min(cut):].strip() if cut else text.strip()
+
+    # -- reporting ------------------------------------------------------------------------
+
+    def _set_state(self, state: str) -> None:
+        with self._lock:
+            self._state = state
+
+    def _emit(self, kind: str, **detail: Any) -> None:
+        if self._on_event is None:
+            return
+        try:
+            self._on_event(SpeechEvent(kind, time.time(), detail))
+        except Exception:
+            log.exception("the speech event handler failed for %s", kind)
+
+
+class _DeviceLost(RuntimeError):
+    pass
+
+
+def _close(stream: Any) -> None:
+    try:
+        stream.stop()
+    except Exception as exc:
+        log.debug("stopping the audio stream: %s", exc)
+    try:
+        stream.close()
+    except Exception as exc:
+        log.debug("closing the audio stream: %s", exc)
+
+
+def _device_message(exc: BaseException, device: str | int | None) -> str:
+    which = "the default input device" if device is None else f"input device {device!r}"
+    return (f"{which} is not available ({exc}). Plug in a microphone or set speech.device "
+            "(list them with `python -m sounddevice`).")

