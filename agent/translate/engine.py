@@ -1,0 +1,219 @@
+"""Running a GGUF model in-process with llama.cpp: greedy decoding, masked by the RSL automaton.
+
+The mask for each automaton state (which tokens may come next, and the state
+each one leads to) is found once by walking a trie of the vocabulary through
+the automaton, then cached. Sampling a token is then an argmax over a few
+hundred logits, so the grammar costs almost nothing per token, unlike
+llama.cpp's GBNF sampler that checks all 262k Gemma tokens every step.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import threading
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from agent.translate.automaton import ALPHABET, END, RslAutomaton, State
+
+_OPEN_LOCK = threading.Lock()
+
+
+@dataclass(frozen=True)
+class Generation:
+    text: str
+    prompt_tokens: int
+    reused_tokens: int
+    generated_tokens: int
+    prompt_ms: float
+    generate_ms: float
+    finished: bool  # False when the token cap cut it off
+
+
+def open_llama(path: Path, *, n_ctx: int = 2048, lora_path: Path | None = None, n_threads: int = 2
+               ) -> Any:
+    """Load a GGUF model; `lora_path` applies an adapter.
+
+    llama.cpp's repacked CPU weight buffers (AMX on this class of Xeon) crash
+    in decode, so the plain buffers are used; they are just as fast for a
+    model this small.
+    """
+    import llama_cpp
+    import llama_cpp.llama as llama_module
+
+    with _OPEN_LOCK:
+        original = llama_module.llama_cpp.llama_model_default_params
+
+        def plain_buffers() -> Any:
+            params = original()
+            params.use_extra_bufts = False
+            return params
+
+        llama_module.llama_cpp.llama_model_default_params = plain_buffers
+        try:
+            return llama_cpp.Llama(model_path=str(path), n_ctx=n_ctx, n_batch=512, verbose=False,
+                                   lora_path=None if lora_path is None else str(lora_path),
+                                   n_threads=n_threads)
+        finally:
+            llama_module.llama_cpp.llama_model_default_params = original
+
+
+class _Trie:
+    __slots__ = ("children", "tokens")
+
+    def __init__(self) -> None:
+        self.children: dict[str, _Trie] = {}
+        self.tokens: list[int] = []
+
+
+class Vocabulary:
+    """The model's token pieces that can occur in RSL, as a trie."""
+
+    def __init__(self, llm: Any) -> None:
+        import llama_cpp
+
+        vocab = llm._model.vocab
+        n_vocab = llm.n_vocab()
+        buffer = ctypes.create_string_buffer(64)
+        self.pieces: list[bytes] = []
+        self.root = _Trie()
+        for token in range(n_vocab):
+            n = llama_cpp.llama_token_to_piece(vocab, token, buffer, 64, 0, False)
+            piece = buffer.raw[:n] if n > 0 else b""
+            self.pieces.append(piece)
+            if not piece or llama_cpp.llama_vocab_is_control(vocab, token):
+                continue
+            try:
+                text = piece.decode("ascii")
+            except UnicodeDecodeError:
+                continue
+            if all(c in ALPHABET for c in text):
+                node = self.root
+                for char in text:
+                    node = node.children.setdefault(char, _Trie())
+                node.tokens.append(token)
+        self.eos = llm.token_eos()
+
+
+class TokenMasks:
+    """For each automaton state: the allowed tokens and the state after each."""
+
+    def __init__(self, automaton: RslAutomaton, vocabulary: Vocabulary) -> None:
+        self.automaton = automaton
+        self.vocabulary = vocabulary
+        self._cache: dict[State, tuple[np.ndarray, list[State]]] = {}
+        self._closing: dict[State, tuple[np.ndarray, list[State]]] = {}
+
+    def closing(self, state: State) -> tuple[np.ndarray, list[State]]:
+        """The tokens from `state` that end the program without starting another statement."""
+        found = self._closing.get(state)
+        if found is None:
+            ids, states = self.at(state)
+            keep = [i for i, s in enumerate(states) if s in (END, ("S", True))
+                    and b";" not in self.vocabulary.pieces[int(ids[i])]]
+            found = (ids[keep], [states[i] for i in keep])
+            self._closing[state] = found
+        return found
+
+    def at(self, state: State) -> tuple[np.ndarray, list[State]]:
+        found = self._cache.get(state)
+        if found is None:
+            ids: list[int] = []
+            states: list[State] = []
+            self._collect(state, self.vocabulary.root, ids, states)
+            found = (np.asarray(ids, dtype=np.int64), states)
+            self._cache[state] = found
+        return found
+
+    def _collect(self, state: State, node: _Trie, ids: list[int], states: list[State]) -> None:
+        step = self.automaton.step
+        for char, child in node.children.items():
+            after = step(state, char)
+            if after is None:
+                continue
+            if child.tokens:
+                ids.extend(child.tokens)
+                states.extend([after] * len(child.tokens))
+            if after != END:
+                self._collect(after, child, ids, states)
+
+
+class LocalEngine:
+    """A loaded model; `generate` continues a prompt greedily, reusing the KV cache of a shared prefix."""
+
+    def __init__(self, path: Path, *, lora_path: Path | None = None, n_ctx: int = 2048) -> None:
+        self.path = path
+        self.llm = open_llama(path, n_ctx=n_ctx, lora_path=lora_path)
+        self.vocabulary = Vocabulary(self.llm)
+        self.chat_template: str = self.llm.metadata.get("tokenizer.chat_template", "")
+        self._masks: dict[Any, TokenMasks] = {}
+
+    def masks(self, automaton: RslAutomaton) -> TokenMasks:
+        masks = self._masks.get(automaton.key)
+        if masks is None:
+            if len(self._masks) > 64:
+                self._masks.clear()
+            masks = self._masks[automaton.key] = TokenMasks(automaton, self.vocabulary)
+        return masks
+
+    def generate(self, prompt: str, automaton: RslAutomaton | None, max_tokens: int) -> Generation:
+        import llama_cpp
+
+        llm = self.llm
+        started = time.perf_counter()
+        tokens = llm.tokenize(prompt.encode("utf-8"), add_bos=True, special=False)
+        if len(tokens) + max_tokens > llm.n_ctx():
+            raise ValueError(f"the prompt is {len(tokens)} tokens; with {max_tokens} to generate it does not "
+                             f"fit the context of {llm.n_ctx()}. Shorten the task.")
+        reused = 0
+        cached = llm.input_ids[:llm.n_tokens]
+        limit = min(len(cached), len(tokens) - 1)
+        while reused < limit and cached[reused] == tokens[reused]:
+            reused += 1
+        llm.n_tokens = reused
+        llm.eval(tokens[reused:])
+        prompt_done = time.perf_counter()
+
+        n_vocab = llm.n_vocab()
+        masks = None if automaton is None else self.masks(automaton)
+        state: State = ("S", False)
+        out = bytearray()
+        generated = 0
+        finished = False
+        pieces = self.vocabulary.pieces
+        while generated < max_tokens:
+            logits = np.ctypeslib.as_array(llama_cpp.llama_get_logits_ith(llm._ctx.ctx, -1), shape=(n_vocab,))
+            if masks is None:
+                token = int(np.argmax(logits))
+                if token == self.vocabulary.eos:
+                    finished = True
+                    break
+            else:
+                full = out.count(b";") >= automaton.max_statements  # type: ignore[union-attr]
+                ids, states = masks.closing(state) if full else masks.at(state)
+                if len(ids) == 0:
+                    break
+                choice = int(np.argmax(logits[ids]))
+                token, state = int(ids[choice]), states[choice]
+            out += pieces[token]
+            generated += 1
+            if state == END or (masks is None and b"\n\n" in out):
+                finished = True
+                break
+            llm.eval([token])
+        text = out.decode("utf-8", errors="replace")
+        if masks is None and "\n\n" in text:
+            text = text[: text.index("\n\n") + 2]
+        done = time.perf_counter()
+        return Generation(text=text, prompt_tokens=len(tokens), reused_tokens=reused, generated_tokens=generated,
+                          prompt_ms=(prompt_done - started) * 1000, generate_ms=(done - prompt_done) * 1000,
+                          finished=finished)
+
+    def close(self) -> None:
+        close = getattr(self.llm, "close", None)
+        if close is not None:
+            close()

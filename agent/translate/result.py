@@ -1,0 +1,51 @@
+"""The records a translation produces: every attempt, and the final verdict."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from rsl.diagnostics import Diagnostic
+from rsl.plan import Plan
+
+
+@dataclass(frozen=True)
+class Attempt:
+    """One generated candidate and what the compiler said about it."""
+
+    program: str
+    diagnostics: tuple[Diagnostic, ...]
+
+    @property
+    def ok(self) -> bool:
+        return not self.diagnostics
+
+    def to_json_dict(self) -> dict[str, Any]:
+        return {"program": self.program, "diagnostics": [d.to_dict() for d in self.diagnostics]}
+
+
+@dataclass(frozen=True)
+class TranslationResult:
+    """The outcome of `Translator.translate`; `plan` is set only when verified."""
+
+    task: str
+    program: str
+    verified: bool
+    passes: int
+    attempts: tuple[Attempt, ...]
+    plan: Plan | None
+    model: str
+    timings_ms: dict[str, float] = field(default_factory=dict)
+
+    def to_json_dict(self) -> dict[str, Any]:
+        """The `nrtrans translate --json` contract; keep the keys stable."""
+        return {
+            "task": self.task,
+            "program": self.program,
+            "verified": self.verified,
+            "passes": self.passes,
+            "attempts": [a.to_json_dict() for a in self.attempts],
+            "plan": self.plan.to_list() if self.plan is not None else [],
+            "model": self.model,
+            "timings_ms": {k: round(v, 3) for k, v in self.timings_ms.items()},
+        }

@@ -1,0 +1,295 @@
+"""The translation loop: task text -> prompt -> grammar-limited generation -> compile -> repair.
+
+Every candidate is compiled. When the compiler objects, its one-line
+diagnostics are appended to the prompt and the failing clauses are
+generated again, at most `max_passes` times in all. Only a program that
+compiles without a diagnostic comes back with a plan.
+"""
+
+from __future__ import annotations
+
+import re
+import threading
+import time
+from collections.abc import Callable, Collection
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Protocol
+
+from agent.normalize import normalize_task
+from agent.translate.automaton import RslAutomaton
+from agent.translate.clauses import Clause, split_clauses
+from agent.translate.engine import Generation
+from agent.translate.prompt import (
+    Shot,
+    chat_prompt,
+    completion_prompt,
+    feedback,
+    load_shots,
+    pick_shots,
+    system_text,
+)
+from agent.translate.result import Attempt, TranslationResult
+from rsl.compiler import compile_program
+from rsl.diagnostics import Code, Diagnostic
+from rsl.profile import Profile
+
+MAX_TOKENS = 160
+# One clause rarely needs more; a square is 8 statements.
+CLAUSE_STATEMENTS = 8
+DEFAULT_SHOTS = 4
+_NUMBER = re.compile(r"-?\d*\.?\d+")
+_OBJECT_PHRASE = re.compile(r"\b(?:the|a|an|some|that|this|my|your) ((?:[a-z]+ )?[a-z]+)\b")
+_NOT_OBJECTS = frozenset({"left", "right", "start", "origin", "beginning", "way", "same", "other", "front",
+                          "back", "end", "middle", "centre", "center", "robot", "side", "distance", "time",
+                          "little", "bit", "square", "triangle", "circle", "full", "long", "few", "couple",
+                          "point", "position", "spot", "area", "room", "around", "head", "camera"})
+
+
+class Engine(Protocol):
+    chat_template: str
+
+    def generate(self, prompt: str, automaton: RslAutomaton | None, max_tokens: int) -> Generation: ...
+
+    def close(self) -> None: ...
+
+
+@dataclass(frozen=True)
+class Options:
+    grammar: bool = True
+    max_passes: int = 3
+    shots: int = DEFAULT_SHOTS
+    split_clauses: bool = True
+    narrow: bool = True
+    adapter_prompt: bool = False
+
+
+@dataclass
+class _ClauseState:
+    clause: Clause
+    program: str = ""
+    extra: str = ""  # repair feedback appended to this clause's prompt
+    objects: tuple[str, ...] | None = None
+    lines: tuple[int, int] = (0, 0)
+    timings: dict[str, float] = field(default_factory=dict)
+
+
+class Translator:
+    """Turns tasks into verified programs with a model loaded once; `translate` is thread-safe."""
+
+    def __init__(self, profile: Profile, engine: Engine, model_name: str, options: Options) -> None:
+        self.profile = profile
+        self.engine = engine
+        self.model_name = model_name
+        self.options = options
+        self._lock = threading.Lock()
+        self._system = system_text(profile)
+        self._bank: tuple[Shot, ...] = load_shots(profile)
+        self._default_numbers = _convention_numbers(profile)
+        self._automata: dict[Any, RslAutomaton] = {}
+
+    @classmethod
+    def load(cls, profile: Profile, *, model: str | None = None, adapter: str | None = None,
+             grammar: bool = True, max_passes: int = 3, endpoint: str | None = None, shots: int | None = None,
+             split_clauses: bool = True, narrow: bool = True) -> Translator:
+        """Load the model (or connect to `endpoint`).
+
+        `adapter`: None picks the shipped adapter for the embedded default
+        model when it exists, "none" turns adapters off, a path loads that
+        LoRA GGUF. `shots`: None picks the mode's default.
+        """
+        if max_passes < 1:
+            raise ValueError("max_passes must be at least 1")
+        if endpoint:
+            from agent.translate.http import HttpEngine
+
+            engine: Engine = HttpEngine(endpoint, model=model)
+            name = f"{model or 'default'}@{endpoint}"
+            lora = None
+        else:
+            from agent.translate.engine import LocalEngine
+            from agent.translate.model_path import resolve_model
+
+            path = resolve_model(model)
+            lora = _resolve_adapter(adapter, default_model=model in (None, "", "default"))
+            engine = LocalEngine(path, lora_path=lora)
+            name = path.name + (f"+{lora.name}" if lora else "")
+        use_adapter = lora is not None
+        options = Options(grammar=grammar, max_passes=max_passes,
+                          shots=(0 if use_adapter else DEFAULT_SHOTS) if shots is None else shots,
+                          split_clauses=split_clauses, narrow=narrow, adapter_prompt=use_adapter)
+        return cls(profile, engine, name, options)
+
+    def close(self) -> None:
+        with self._lock:
+            self.engine.close()
+
+    def translate(self, task: str, *, known_objects: Collection[str] | None = None,
+                  on_attempt: Callable[[Attempt], None] | None = None) -> TranslationResult:
+        with self._lock:
+            return self._translate(task, known_objects, on_attempt)
+
+    def _translate(self, task: str, known: Collection[str] | None,
+                   on_attempt: Callable[[Attempt], None] | None) -> TranslationResult:
+        started = time.perf_counter()
+        timings = {"prompt": 0.0, "generate": 0.0, "compile": 0.0}
+        normalized = normalize_task(task)
+        if not normalized:
+            return TranslationResult(task=task, program="", verified=False, passes=0, attempts=(), plan=None,
+                                     model=self.model_name, timings_ms={**timings, "total": 0.0})
+        clauses = (split_clauses(normalized, self.profile) if self.options.split_clauses
+                   else [Clause(text=normalized)])
+        states = [_ClauseState(c) for c in clauses]
+        for state in states:
+            state.objects = self._task_objects(state.clause.text)
+        attempts: list[Attempt] = []
+        pending = [s for s in states if not s.clause.repeat_previous]
+        result = None
+        for _ in range(self.options.max_passes):
+            for state in pending:
+                generation = self.engine.generate(self._prompt(state), self._automaton(state), MAX_TOKENS)
+                timings["prompt"] += generation.prompt_ms
+                timings["generate"] += generation.generate_ms
+                state.program = _tidy(generation.text)
+            program = _assemble(states)
+            compile_started = time.perf_counter()
+            result = compile_program(program, self.profile, known)
+            timings["compile"] += (time.perf_counter() - compile_started) * 1000
+            attempt = Attempt(program=program, diagnostics=result.diagnostics)
+            attempts.append(attempt)
+            if on_attempt is not None:
+                on_attempt(attempt)
+            if result.ok:
+                break
+            pending = self._prepare_repair(states, result.diagnostics, known)
+        assert result is not None
+        timings["total"] = (time.perf_counter() - started) * 1000
+        verified = result.ok
+        return TranslationResult(task=task, program=attempts[-1].program, verified=verified,
+                                 passes=len(attempts), attempts=tuple(attempts),
+                                 plan=result.plan if verified else None, model=self.model_name,
+                                 timings_ms=timings)
+
+    def _prompt(self, state: _ClauseState) -> str:
+        text = state.clause.text
+        if self.options.adapter_prompt:
+            from agent.adapter.prompt import adapter_prompt
+
+            return adapter_prompt(text) + state.extra
+        shots = pick_shots(self._bank, text, self.options.shots)
+        if self.engine.chat_template:
+            llm = getattr(self.engine, "llm", None)
+            bos = eos = ""
+            if llm is not None:
+                bos = llm.detokenize([llm.token_bos()]).decode("utf-8", "replace")
+                eos = llm.detokenize([llm.token_eos()]).decode("utf-8", "replace")
+            return chat_prompt(self.engine.chat_template, bos, eos, self._system, shots, text) + state.extra
+        return completion_prompt(self._system, shots, text) + state.extra
+
+    def _automaton(self, state: _ClauseState) -> RslAutomaton | None:
+        if not self.options.grammar:
+            return None
+        numbers = None
+        if self.options.narrow:
+            numbers = self._default_numbers | _task_numbers(state.clause.text)
+        key = (state.objects, None if numbers is None else frozenset(numbers))
+        automaton = self._automata.get(key)
+        if automaton is None:
+            if len(self._automata) > 256:
+                self._automata.clear()
+            cap = CLAUSE_STATEMENTS if self.options.split_clauses else None
+            automaton = self._automata[key] = RslAutomaton(self.profile, objects=state.objects, numbers=numbers,
+                                                           max_statements=cap)
+        return automaton
+
+    def _task_objects(self, text: str) -> tuple[str, ...] | None:
+        """Object names the clause itself mentions (`the red cup` -> red_cup, cup)."""
+        if not self.options.narrow:
+            return None
+        names: list[str] = []
+        for phrase in _OBJECT_PHRASE.findall(text):
+            words = [w for w in phrase.split() if w not in _NOT_OBJECTS]
+            if not words:
+                continue
+            names.append(words[-1])
+            if len(words) == 2:
+                names.append("_".join(words))
+        return tuple(dict.fromkeys(names)) or None
+
+    def _prepare_repair(self, states: list[_ClauseState], diagnostics: tuple[Diagnostic, ...],
+                        known: Collection[str] | None) -> list[_ClauseState]:
+        failing: list[_ClauseState] = []
+        for state in states:
+            if state.clause.repeat_previous:
+                continue
+            mine = [d for d in diagnostics if state.lines[0] <= d.line <= state.lines[1]]
+            if not mine:
+                continue
+            if any(d.code is Code.UNKNOWN_OBJECT for d in mine) and known:
+                state.objects = tuple(sorted(known))
+            state.extra = feedback(state.program, mine)
+            failing.append(state)
+        if failing:
+            return failing
+        generic = [s for s in states if not s.clause.repeat_previous]
+        for state in generic:
+            state.extra = feedback(state.program, diagnostics)
+        return generic
+
+
+def _tidy(text: str) -> str:
+    """The generated program with exactly one newline after each line and no blank lines."""
+    return "".join(line.rstrip() + "\n" for line in text.splitlines() if line.strip())
+
+
+def _assemble(states: list[_ClauseState]) -> str:
+    """The whole program, recording which lines each clause produced."""
+    program = ""
+    for state in states:
+        first = program.count("\n") + 1
+        if state.clause.repeat_previous:
+            program = program * max(1, state.clause.repeat)
+        else:
+            program += state.program * max(1, state.clause.repeat)
+        state.lines = (first, program.count("\n"))
+    return program
+
+
+def _task_numbers(text: str) -> set[str]:
+    numbers = set()
+    for match in _NUMBER.findall(text):
+        value = match.lstrip("-")
+        numbers.update({value, "-" + value})
+    return numbers
+
+
+def _convention_numbers(profile: Profile) -> set[str]:
+    """Numbers a task may imply without saying them: the profile's conventions, polygon turns, zero."""
+    from rsl.plan import format_number
+
+    numbers = {"0"}
+    for convention in profile.conventions:
+        numbers.update(_NUMBER.findall(convention.program))
+        numbers.update(_NUMBER.findall(convention.meaning))
+    numbers.update(format_number(6.283185307179586 / sides) for sides in range(3, 9))
+    return {n.lstrip("-") for n in numbers if n.lstrip("-") not in ("", ".")}
+
+
+def _resolve_adapter(adapter: str | None, *, default_model: bool) -> Path | None:
+    if adapter is not None and adapter.lower() in ("none", "off", ""):
+        return None
+    if adapter is None:
+        if not default_model:
+            return None
+        try:
+            from agent.adapter.prompt import DEFAULT_ADAPTER
+        except ImportError:
+            return None
+        return DEFAULT_ADAPTER if DEFAULT_ADAPTER.is_file() else None
+    path = Path(adapter).expanduser()
+    if not path.is_file():
+        from agent.translate.model_path import ModelNotFoundError
+
+        raise ModelNotFoundError(f"no adapter at {path}: the file does not exist. Give the path of a LoRA "
+                                 "GGUF file, or train one with `nrtrans train-adapter`.")
+    return path
