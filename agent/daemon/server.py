@@ -191,14 +191,12 @@ class SocketServer:
     async def _accept(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
         sock = writer.get_extra_info("socket")
         peer = peer_credentials(sock)
-        client = Client(self, reader, writer, peer)
-        writer_task = asyncio.create_task(client.write_loop())
         refusal = self._refusal(peer)
         if refusal is not None:
-            client.send(refusal)
-            client.close()
-            await writer_task
+            await _refuse(reader, writer, refusal)
             return
+        client = Client(self, reader, writer, peer)
+        writer_task = asyncio.create_task(client.write_loop())
         self.clients.add(client)
         try:
             await client.read_loop()
@@ -276,6 +274,25 @@ class SocketServer:
             records = await asyncio.to_thread(service.audit.recent, int(body.get("limit", 20)))
             return reply_frame(request, tasks=records)
         raise AssertionError(f"no handler for {request.op}")
+
+
+async def _refuse(reader: asyncio.StreamReader, writer: asyncio.StreamWriter, refusal: dict[str, Any]) -> None:
+    """Send one error and close gracefully.
+
+    What the client already sent is read and dropped first: closing a Unix socket with
+    unread data resets the connection, and the client would never see the reason.
+    """
+    try:
+        writer.write(encode(refusal))
+        await writer.drain()
+        writer.write_eof()
+        async with asyncio.timeout(2.0):
+            while await reader.read(_READ_CHUNK):
+                pass
+    except (TimeoutError, ConnectionError, OSError):
+        pass
+    finally:
+        writer.close()
 
 
 def _bind(path: Path, mode: int) -> socket.socket:

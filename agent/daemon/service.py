@@ -147,10 +147,16 @@ class Service:
                     f"an emergency stop is latched ({self._estop_reason})",
                     "check that the robot is safe, then send `reset` (`nrtrans reset`)",
                 )
-            if before_queue is not None:
-                before_queue(task)
+
+            def accept(position: int) -> None:
+                if before_queue is not None:
+                    before_queue(task)
+                # On disk before the reply, so an accepted task is never missing from the log.
+                self.audit.write(task.record())
+                self.events.publish("queued", task.id, source=source, position=position, text=text, rsl=rsl)
+
             try:
-                position = self.queue.put(task)
+                position = self.queue.put(task, accept)
             except Busy as exc:
                 raise ProtocolError(
                     "busy",
@@ -158,9 +164,6 @@ class Service:
                     "wait for a task to finish (`nrtrans events`) and submit again",
                 ) from exc
             self._remember(task)
-        # Written before the reply, so an accepted task is never missing from the log.
-        self.audit.write(task.record())
-        self.events.publish("queued", task.id, source=source, position=position, text=text, rsl=rsl)
         return task, position
 
     def task(self, task_id: str) -> Task:

@@ -10,6 +10,7 @@ import threading
 import time
 import uuid
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import Enum
 from typing import Any
@@ -103,16 +104,23 @@ class TaskQueue:
         self._cond = threading.Condition()
         self._closed = False
 
-    def put(self, task: Task) -> int:
-        """Queue `task`; returns how many wait ahead of it. Raises `Busy` when full."""
+    def put(self, task: Task, on_accept: Callable[[int], None] | None = None) -> int:
+        """Queue `task`; returns how many wait ahead of it. Raises `Busy` when full.
+
+        `on_accept(position)` runs before the worker can see the task, so whatever it
+        records or announces comes before anything the worker does with it.
+        """
         with self._cond:
             if self._closed:
                 raise Busy("the daemon is shutting down")
             if len(self._items) >= self.capacity:
                 raise Busy(f"{len(self._items)} tasks are already waiting (the limit is {self.capacity})")
+            position = len(self._items)
+            if on_accept is not None:
+                on_accept(position)
             self._items.append(task)
             self._cond.notify()
-            return len(self._items) - 1
+            return position
 
     def get(self) -> Task | None:
         """The next task, waiting for one; None once the queue is closed."""
