@@ -10,6 +10,7 @@ llama.cpp's GBNF sampler that checks all 262k Gemma tokens every step.
 from __future__ import annotations
 
 import ctypes
+import os
 import threading
 import time
 from dataclasses import dataclass
@@ -34,7 +35,7 @@ class Generation:
     finished: bool  # False when the token cap cut it off
 
 
-def open_llama(path: Path, *, n_ctx: int = 2048, lora_path: Path | None = None, n_threads: int = 2
+def open_llama(path: Path, *, n_ctx: int = 2048, lora_path: Path | None = None, n_threads: int | None = None
                ) -> Any:
     """Load a GGUF model; `lora_path` applies an adapter.
 
@@ -45,6 +46,11 @@ def open_llama(path: Path, *, n_ctx: int = 2048, lora_path: Path | None = None, 
     import llama_cpp
     import llama_cpp.llama as llama_module
 
+    if n_threads is None:
+        # All cores of the small robot computer; NRTRANS_THREADS overrides it
+        # where other work shares them (spinning llama.cpp threads that lose
+        # their core make decoding slower, not faster).
+        n_threads = int(os.environ.get("NRTRANS_THREADS", "0")) or min(4, os.cpu_count() or 1)
     with _OPEN_LOCK:
         original = llama_module.llama_cpp.llama_model_default_params
 

@@ -1,0 +1,112 @@
+"""`nrtrans translate`: one task in, a verified RSL program out."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from typing import Any
+
+EXIT_VERIFIED, EXIT_UNVERIFIED, EXIT_USAGE = 0, 1, 2
+
+
+def add_model_options(parser: argparse.ArgumentParser) -> None:
+    """Options shared by `translate` and `eval`."""
+    parser.add_argument("--model", metavar="NAME|PATH",
+                        help="GGUF model file or a name from `nrtrans models list` "
+                             "(default: the embedded Gemma 3 270M)")
+    parser.add_argument("--adapter", metavar="PATH|none",
+                        help="LoRA adapter GGUF; default: the shipped adapter with the default model; "
+                             "`none` turns it off")
+    parser.add_argument("--max-passes", type=int, default=3, metavar="N",
+                        help="generate-and-compile passes before giving up (default: 3)")
+    parser.add_argument("--no-grammar", action="store_true",
+                        help="sample without the RSL grammar (the unconstrained setting, for comparison)")
+    parser.add_argument("--shots", type=int, default=None, metavar="N",
+                        help="worked examples in the prompt (default: 4 without an adapter, 0 with one)")
+    parser.add_argument("--no-split", action="store_true",
+                        help="translate the task in one go instead of clause by clause")
+    parser.add_argument("--no-narrow", action="store_true",
+                        help="do not narrow the grammar to the objects and numbers the task mentions")
+    parser.add_argument("--profile", metavar="FILE", help="robot profile TOML (default: the built-in robot)")
+    parser.add_argument("--endpoint", metavar="URL",
+                        help="use an OpenAI-compatible server (llama.cpp's) at URL instead of the local model")
+
+
+def load_translator(args: argparse.Namespace) -> Any:
+    """A Translator for the parsed options; raises with a clear message on bad ones."""
+    from agent.translate import Translator
+    from rsl.profile import load_profile
+
+    if args.max_passes < 1:
+        raise ValueError(f"--max-passes must be at least 1, got {args.max_passes}")
+    profile = load_profile(args.profile)
+    return Translator.load(profile, model=args.model, adapter=args.adapter, grammar=not args.no_grammar,
+                           max_passes=args.max_passes, endpoint=args.endpoint, shots=args.shots,
+                           split_clauses=not args.no_split, narrow=not args.no_narrow)
+
+
+def register(subparsers: Any) -> None:
+    parser = subparsers.add_parser(
+        "translate", help="translate a task into a verified RSL program",
+        description="Translate a task in plain language into an RSL program with the on-device LLM, "
+                    "sampling under the RSL grammar and repairing it with the compiler's diagnostics. "
+                    "Prints the verified program. Exit status: 0 verified, 1 not verified, 2 usage error.",
+        epilog='Example: nrtrans translate "move forward two meters, then grasp the cup" --objects cup')
+    parser.add_argument("task", help="the task, in quotes")
+    parser.add_argument("--json", action="store_true",
+                        help="print one JSON object: task, program, verified, passes, attempts, plan, "
+                             "model, timings_ms")
+    parser.add_argument("--objects", metavar="A,B",
+                        help="objects the robot knows; other object names are errors to repair")
+    parser.add_argument("-v", "--verbose", action="store_true",
+                        help="show every attempt and its diagnostics on standard error")
+    add_model_options(parser)
+    parser.set_defaults(func=_translate)
+
+
+def parse_objects(text: str | None) -> list[str] | None:
+    if text is None:
+        return None
+    return [name.strip() for name in text.split(",") if name.strip()]
+
+
+def _translate(args: argparse.Namespace) -> int:
+    from agent.translate import ModelNotFoundError
+    from agent.translate.http import EndpointError
+    from rsl.profile import ProfileError
+
+    if not args.task.strip():
+        print("nrtrans translate: error: the task is empty.\n  Give the task in quotes, e.g. "
+              "nrtrans translate \"turn left 90 degrees\"", file=sys.stderr)
+        return EXIT_USAGE
+    try:
+        translator = load_translator(args)
+    except (ModelNotFoundError, ProfileError, EndpointError, ValueError) as exc:
+        print(f"nrtrans translate: error: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+
+    def show(attempt: Any) -> None:
+        if args.verbose:
+            print(f"-- attempt\n{attempt.program}", file=sys.stderr, end="")
+            for diagnostic in attempt.diagnostics:
+                print(diagnostic.render(), file=sys.stderr, end="")
+
+    try:
+        result = translator.translate(args.task, known_objects=parse_objects(args.objects), on_attempt=show)
+    except (EndpointError, ValueError) as exc:
+        print(f"nrtrans translate: error: {exc}", file=sys.stderr)
+        return EXIT_UNVERIFIED
+    finally:
+        translator.close()
+    if args.json:
+        print(json.dumps(result.to_json_dict(), indent=2))
+    elif result.verified:
+        print(result.program, end="")
+    else:
+        print(f"nrtrans translate: could not verify a program in {result.passes} pass(es); "
+              "the last attempt was:", file=sys.stderr)
+        print(result.program, file=sys.stderr, end="")
+        for diagnostic in result.attempts[-1].diagnostics if result.attempts else ():
+            print(diagnostic.render(), file=sys.stderr, end="")
+    return EXIT_VERIFIED if result.verified else EXIT_UNVERIFIED
