@@ -1,0 +1,78 @@
+"""Running a translator over the suite and summarizing per group."""
+
+from __future__ import annotations
+
+import statistics
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from agent.evalsuite.suite import GROUPS, EvalTask, accepts
+from rsl.profile import Profile
+
+
+@dataclass(frozen=True)
+class TaskOutcome:
+    task: EvalTask
+    program: str
+    verified: bool
+    accepted: bool
+    passes: int
+    latency_ms: float
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"group": self.task.group, "task": self.task.task, "program": self.program,
+                "verified": self.verified, "accepted": self.accepted, "passes": self.passes,
+                "latency_ms": round(self.latency_ms, 1), "holdout": self.task.holdout}
+
+
+def run_suite(translator: Any, tasks: Sequence[EvalTask], profile: Profile,
+              progress: Callable[[int, int, TaskOutcome], None] | None = None) -> list[TaskOutcome]:
+    outcomes = []
+    for index, task in enumerate(tasks, start=1):
+        result = translator.translate(task.task, known_objects=task.objects)
+        outcome = TaskOutcome(task=task, program=result.program, verified=result.verified,
+                              accepted=accepts(task, result.plan, profile), passes=result.passes,
+                              latency_ms=result.timings_ms.get("total", 0.0))
+        outcomes.append(outcome)
+        if progress is not None:
+            progress(index, len(tasks), outcome)
+    return outcomes
+
+
+def percentile(values: Sequence[float], fraction: float) -> float:
+    """Nearest-rank percentile; 0 for no values."""
+    if not values:
+        return 0.0
+    ordered = sorted(values)
+    rank = max(1, min(len(ordered), round(fraction * len(ordered) + 0.5)))
+    return ordered[rank - 1]
+
+
+def summarize(outcomes: Sequence[TaskOutcome]) -> dict[str, dict[str, float]]:
+    """Per group and `overall`: n, success, accuracy, mean passes, latency p50/p95 (ms)."""
+    table: dict[str, dict[str, float]] = {}
+    buckets = [(g, [o for o in outcomes if o.task.group == g]) for g in GROUPS]
+    buckets.append(("overall", list(outcomes)))
+    for name, group in buckets:
+        if not group:
+            continue
+        latencies = [o.latency_ms for o in group]
+        table[name] = {
+            "n": len(group),
+            "success": sum(o.verified for o in group) / len(group),
+            "accuracy": sum(o.accepted for o in group) / len(group),
+            "mean_passes": statistics.fmean(o.passes for o in group),
+            "latency_p50_ms": percentile(latencies, 0.5),
+            "latency_p95_ms": percentile(latencies, 0.95),
+        }
+    return table
+
+
+def render_table(table: dict[str, dict[str, float]]) -> str:
+    header = f"{'group':<12} {'n':>4} {'success':>8} {'accuracy':>9} {'passes':>7} {'p50 ms':>8} {'p95 ms':>8}"
+    lines = [header, "-" * len(header)]
+    for name, row in table.items():
+        lines.append(f"{name:<12} {int(row['n']):>4} {row['success']:>8.1%} {row['accuracy']:>9.1%} "
+                     f"{row['mean_passes']:>7.2f} {row['latency_p50_ms']:>8.0f} {row['latency_p95_ms']:>8.0f}")
+    return "\n".join(lines)
