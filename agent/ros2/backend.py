@@ -38,6 +38,7 @@ JOINT_TOLERANCE = 0.01  # rad, or m for the gripper
 STILL_LINEAR = 0.01  # m/s; slower than this counts as standing still
 STILL_ANGULAR = 0.02  # rad/s
 DISCOVERY_WAIT = 3.0  # s to wait for a subscriber before calling a topic dead
+FIRST_MESSAGE_WAIT = 2.0  # s to wait for the first joint states or objects after connecting
 
 
 class RobotUnavailable(RuntimeError):
@@ -273,21 +274,24 @@ class Ros2Robot:
         while True:
             odom = self._fresh_odometry()
             remaining = amount - progress(odom.pose)
-            if abs(remaining) <= tolerance:
-                break
             self._check_interrupts(token)
             if time.monotonic() > deadline:
                 raise StepFailure(f"{what} timed out after {budget:.1f} s with {abs(remaining):.3f} "
                                   "still to go; the base was stopped. Is something blocking the robot?")
-            speed = next_speed(remaining, speed, limits, CONTROL_PERIOD)
-            linear, angular = command(speed, odom.pose)
+            if abs(remaining) <= tolerance:
+                # Done only once the base stands still inside the tolerance: a late
+                # odometry message or a slow brake can carry it out again, and then
+                # the loop drives back.
+                if abs(odom.linear) < STILL_LINEAR and abs(odom.angular) < STILL_ANGULAR:
+                    return
+                speed, (linear, angular) = 0.0, (0.0, 0.0)
+            else:
+                speed = next_speed(remaining, speed, limits, CONTROL_PERIOD)
+                linear, angular = command(speed, odom.pose)
             with self._publish_lock:
                 self._check_interrupts(token)
                 self._link.send_twist(linear, angular)
             token.wait(CONTROL_PERIOD)
-        with self._publish_lock:
-            self._link.send_zero_twist()
-        self._settle(token)
 
     def _drive_to_goal(self, x: float, y: float, heading: float, token: CancelToken,
                        check_heading: bool) -> None:
@@ -392,6 +396,12 @@ class Ros2Robot:
     def _fresh_joints(self, names: list[str]) -> dict[str, float]:
         joints, received = self._link.joints()
         missing = [n for n in names if n not in joints]
+        deadline = time.monotonic() + FIRST_MESSAGE_WAIT
+        while missing and time.monotonic() < deadline:
+            # Just connected: joint states repeat, so the first one is near.
+            time.sleep(0.02)
+            joints, received = self._link.joints()
+            missing = [n for n in names if n not in joints]
         if missing:
             raise StepFailure(f"no position for joint(s) {', '.join(missing)} on {self.config.joint_states}; "
                               "check the joint names in the profile's [ros] table and that the "
@@ -401,15 +411,6 @@ class Ros2Robot:
             raise StepFailure(f"joint states on {self.config.joint_states} are stale "
                               f"(last arrived {age:.2f} s ago)")
         return {n: joints[n] for n in names}
-
-    def _settle(self, token: CancelToken) -> None:
-        """Wait briefly for the base to stand still, so the next step starts from rest."""
-        deadline = time.monotonic() + 1.0
-        while time.monotonic() < deadline and not token.is_set():
-            odom = self._fresh_odometry()
-            if abs(odom.linear) < STILL_LINEAR and abs(odom.angular) < STILL_ANGULAR:
-                return
-            token.wait(CONTROL_PERIOD)
 
     def _check_interrupts(self, token: CancelToken) -> None:
         if token.is_set():
@@ -427,6 +428,11 @@ class Ros2Robot:
 
     def _object_position(self, name: str) -> tuple[float, float]:
         report, error = self._link.objects()
+        deadline = time.monotonic() + FIRST_MESSAGE_WAIT
+        while report is None and name not in self._known and time.monotonic() < deadline:
+            # Just connected: the objects topic repeats, so its next message is near.
+            time.sleep(0.05)
+            report, error = self._link.objects()
         if report is not None and name in report.objects:
             return report.objects[name]
         if name in self._known:

@@ -91,6 +91,7 @@ class SimBridge:
         steps = int(self._owed / world.dt)
         self._owed -= steps * world.dt
         if self._follower.goal is not None:
+            # A goal at the robot's own pose is how clients cancel one; it is reached at once.
             world.set_base_velocity(*self._follower.command(world.base_pose(), steps * world.dt))
         elif now - self._cmd_at > CMD_VEL_TIMEOUT:
             world.set_base_velocity(0.0, 0.0)
@@ -139,11 +140,15 @@ class SimBridge:
     # -- commands ----------------------------------------------------------------------
 
     def _on_cmd_vel(self, msg: Any) -> None:
-        # Like a twist multiplexer: a direct velocity command overrides a goal in progress.
-        self._follower.clear()
         self._cmd = (float(msg.linear.x), float(msg.angular.z))
+        if self._cmd != (0.0, 0.0):
+            # Like a twist multiplexer: driving by hand overrides a goal in progress. A zero
+            # Twist does not, because DDS does not order it against a goal on another topic:
+            # the zero that ends one step could otherwise cancel the next step's goal.
+            self._follower.clear()
         self._cmd_at = time.monotonic()
-        self.world.set_base_velocity(*self._cmd)
+        if self._follower.goal is None:
+            self.world.set_base_velocity(*self._cmd)
 
     def _on_goal(self, msg: Any) -> None:
         frame = msg.header.frame_id

@@ -1,0 +1,76 @@
+"""The shared robot programs, run through the ROS 2 backend against `nrtrans sim-bridge`
+over real DDS: the backend here, the simulated robot in another process."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import pytest
+
+from agent.robot import CancelToken, RobotState
+from agent.ros2.backend import Ros2Robot
+from rsl.compiler import compile_program
+from rsl.plan import ObjectRef
+from rsl.profile import Profile
+
+REALTIME_FACTOR = 2.0
+
+
+@dataclass(frozen=True)
+class Scenario:
+    name: str
+    program: str
+    pose: tuple[float, float, float]  # x, y, heading the robot must end at
+    holding: str | None = None
+    seen: tuple[str, ...] = ()
+
+
+SCENARIOS = [
+    Scenario("square_left", "forward 1; turnleft 1.5708; forward 1; turnleft 1.5708; "
+                            "forward 1; turnleft 1.5708; forward 1; turnleft 1.5708;", (0.0, 0.0, 0.0)),
+    Scenario("square_right_backward", "backward 0.5; turnright 1.5708; forward 0.5; turnright 1.5708; "
+                                      "forward 0.5;", (-1.0, -0.5, math.pi)),
+    Scenario("approach_then_grasp", "approach table; grasp cup;", (2.1, 0.0, 0.0), holding="cup"),
+    Scenario("look_around", "lookdown 0.3; lookleft 1.5708; perceive; lookright 3.1416; perceive; "
+                            "lookleft 1.5708; lookup 0.3;", (0.0, 0.0, 0.0), seen=("ball", "book", "banana")),
+    Scenario("goto_and_back", "goto 1.5, -1; goto 0, 0;", (0.0, 0.0, None)),  # type: ignore[arg-type]
+]
+
+
+def run_program(robot: Ros2Robot, profile: Profile, program: str) -> RobotState:
+    result = compile_program(program, profile)
+    assert result.ok, [d.brief() for d in result.diagnostics]
+    assert result.plan is not None
+    for command in result.plan:
+        args = [a.name if isinstance(a, ObjectRef) else a.value for a in command.args]
+        outcome = getattr(robot, command.skill)(*args, cancel=CancelToken())
+        assert outcome.ok, f"`{command.to_rsl()}` {outcome.status.value}: {outcome.reason}"
+    return robot.state()
+
+
+@pytest.mark.parametrize("scenario", SCENARIOS, ids=lambda s: s.name)
+def test_scenario_ends_where_expected(scenario: Scenario, robot: Ros2Robot, profile: Profile) -> None:
+    state = run_program(robot, profile, scenario.program)
+    x, y, heading = scenario.pose
+    assert math.hypot(state.pose.x - x, state.pose.y - y) < 0.05, state.pose
+    if heading is not None:
+        off = abs(math.remainder(state.pose.heading - heading, 2 * math.pi))
+        assert off < math.radians(2.0), state.pose
+    assert state.holding == scenario.holding
+    assert abs(state.head_pan) < 0.03 and abs(state.head_tilt) < 0.03
+    known = {name for name, _x, _y in state.known_objects}
+    assert set(scenario.seen) <= known, known
+
+
+def test_each_straight_move_and_turn_is_within_2cm_and_1_degree(robot: Ros2Robot) -> None:
+    start = robot.state().pose
+    assert robot.forward(0.73).ok
+    moved = robot.state().pose
+    assert abs(math.hypot(moved.x - start.x, moved.y - start.y) - 0.73) < 0.02
+    assert robot.turnright(2.5).ok
+    turned = robot.state().pose
+    assert abs(math.remainder(turned.heading - (moved.heading - 2.5), 2 * math.pi)) < math.radians(1.0)
+    assert robot.turnleft(6.2832 + 0.5).ok  # more than a full circle must count the full circle
+    again = robot.state().pose
+    assert abs(math.remainder(again.heading - (turned.heading + 0.5), 2 * math.pi)) < math.radians(1.0)
