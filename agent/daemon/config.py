@@ -115,6 +115,14 @@ class TranslatorConfig:
     grammar: bool = field(
         default=True, metadata=_doc("Limit sampling to the RSL grammar generated from the robot profile.")
     )
+    warmup: bool = field(
+        default=True,
+        metadata=_doc(
+            "After READY=1, translate one example task from the robot profile in the background, "
+            "so the first real task finds the model's prompt cache and token masks warm. A task "
+            "submitted meanwhile waits for it."
+        ),
+    )
     max_passes: int = field(
         default=3,
         metadata=_doc("Most translation attempts per task (the first plus repairs from compiler diagnostics).", min=1),

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import asyncio
 import logging
+import os
 import signal
 import sys
 import time
@@ -40,13 +41,22 @@ def serve(config: Config, *, config_file: Path | None = None, reload: Callable[[
         service.shutdown("startup failed")
         return 1
     try:
-        return asyncio.run(_serve(service, notifier, started, config_file, reload))
+        code = asyncio.run(_serve(service, notifier, started, config_file, reload))
     except StartupError as exc:
         print(f"nrtrans serve: error: {exc}", file=sys.stderr)
         service.shutdown("startup failed")
-        return 1
+        code = 1
     finally:
         notifier.close()
+    if service.worker_busy():
+        # Still inside the model after the grace period, with every record already final:
+        # leave now rather than finalize the interpreter under a running native thread.
+        log.warning("the translator did not finish within the grace period; exiting without waiting for it")
+        logging.shutdown()
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    return code
 
 
 async def _serve(

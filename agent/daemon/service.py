@@ -49,6 +49,7 @@ class Service:
         self._stopping = False
         self._worker: threading.Thread | None = None
         self._worker_error: str | None = None
+        self.warm_s: float | None = None
 
     # -- start and stop -------------------------------------------------------------------------
 
@@ -89,7 +90,8 @@ class Service:
         for task in self.queue.drain():
             self._finish(task, TaskState.CANCELLED, reason)
         if self._worker is not None:
-            self._worker.join(self.config.tasks.shutdown_grace)
+            # Only a task in progress is worth waiting for; a warm-up translation is not.
+            self._worker.join(self.config.tasks.shutdown_grace if current is not None else 1.0)
             if self._worker.is_alive() and current is not None:
                 # Still inside a translation that cannot be interrupted; nothing has moved.
                 self._finish(current, TaskState.CANCELLED, reason)
@@ -97,9 +99,13 @@ class Service:
             _quietly(self.speech.stop)
         if self.robot is not None:
             _quietly(self.robot.close)
-        if self.translator is not None:
+        if self.translator is not None and not self.worker_busy():
+            # A translation still running holds the model; the process exits without waiting for it.
             _quietly(self.translator.close)
         self.audit.close()
+
+    def worker_busy(self) -> bool:
+        return self._worker is not None and self._worker.is_alive()
 
     def alive(self) -> bool:
         return self._worker is not None and self._worker.is_alive() and self._worker_error is None
@@ -241,6 +247,7 @@ class Service:
             "worker": {"ok": self.alive(), **({"detail": self._worker_error} if self._worker_error else {})},
             "translator": {
                 "ok": self.translator is not None,
+                "warm_s": self.warm_s,
                 "model": getattr(self.translator, "model_name", None) or self.config.translator.model or "embedded",
             },
             "robot": robot,
@@ -270,6 +277,8 @@ class Service:
     # -- the worker ---------------------------------------------------------------------------
 
     def _work(self) -> None:
+        if self.config.translator.warmup:
+            self._warm_up()
         while True:
             task = self.queue.get()
             if task is None:
@@ -299,6 +308,17 @@ class Service:
                 if self._estop_reason is None
                 else f"EMERGENCY STOP latched: {self._estop_reason}; send reset to resume"
             )
+
+    def _warm_up(self) -> None:
+        examples = [c.task for c in self.profile.conventions] or [s.description for s in self.profile.skills]
+        started = time.monotonic()
+        try:
+            self.translator.translate(examples[0], known_objects=self._known_objects())
+        except Exception as exc:
+            log.warning("the warm-up translation failed (tasks will still be tried): %s", exc)
+            return
+        self.warm_s = round(time.monotonic() - started, 3)
+        log.info("translator warm after %.1f s", self.warm_s)
 
     def _run(self, task: Task) -> None:
         start = time.monotonic()

@@ -114,6 +114,8 @@ class Daemon:
             "api": {"socket": str(self.socket)},
             "robot": {"realtime_factor": 1.0},
             "speech": {"enabled": False},
+            # Only the end-to-end test needs the model warm; the others leave the CPU to the tests.
+            "translator": {"warmup": False},
         }
         for name, values in (settings or {}).items():
             sections.setdefault(name, {}).update(values)

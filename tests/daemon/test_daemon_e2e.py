@@ -13,7 +13,7 @@ from tests.daemon.conftest import Daemon, follow
 
 @pytest.fixture
 def daemon(workdir: Path) -> Iterator[Daemon]:
-    running = Daemon(workdir, {"robot": {"realtime_factor": 0.0}}).start()
+    running = Daemon(workdir, {"robot": {"realtime_factor": 0.0}, "translator": {"warmup": True}}).start()
     yield running
     assert running.stop() == 0, running.output()
 

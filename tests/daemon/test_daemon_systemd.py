@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+from models.store import model_dir
 from tests.daemon.conftest import NRTRANS, NotifyListener
 
 UNITS = Path(__file__).resolve().parents[2] / "systemd"
@@ -83,6 +84,9 @@ def test_execstart_reports_ready_pings_the_watchdog_and_stops_cleanly(workdir: P
         "RUNTIME_DIRECTORY": str(runtime),
         "STATE_DIRECTORY": str(state),
     }
+    # A real install keeps its assembled model in the state directory across restarts; point at
+    # the one already assembled on this machine rather than writing 250 MB per test run.
+    env["NRTRANS_MODEL_DIR"] = str(model_dir())
     for key in ("NRTRANS_CONFIG", "WATCHDOG_PID", "LISTEN_FDS", "LISTEN_PID", "NRTRANS_SOCKET"):
         env.pop(key, None)
     log = open(workdir / "log", "wb")  # noqa: SIM115
