@@ -76,12 +76,20 @@ class GoalFollower:
 
     def _ramp(self, linear: float, angular: float, dt: float) -> tuple[float, float]:
         last_linear, last_angular = self._command
-        step_linear = self.motion.max_linear_accel * dt
-        step_angular = self.motion.max_angular_accel * dt
-        linear = min(max(linear, last_linear - step_linear), last_linear + step_linear)
-        angular = min(max(angular, last_angular - step_angular), last_angular + step_angular)
+        linear = _speed_up(last_linear, linear, self.motion.max_linear_accel * dt)
+        angular = _speed_up(last_angular, angular, self.motion.max_angular_accel * dt)
         self._command = (linear, angular)
         return linear, angular
+
+
+def _speed_up(last: float, target: float, step: float) -> float:
+    """Limit how fast the speed grows, but never delay braking: a goal at the robot's own
+    pose is how clients stop it, and it must stop at once."""
+    if last * target < 0:
+        last = 0.0
+    if abs(target) <= abs(last):
+        return target
+    return last + max(-step, min(step, target - last))
 
 
 def _limit(value: float, bound: float) -> float:

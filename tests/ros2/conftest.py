@@ -40,13 +40,15 @@ REPO = Path(__file__).resolve().parents[2]
 
 @dataclass(frozen=True)
 class TwistSample:
-    at: float  # time.monotonic()
+    at: float  # time.time() when the probe received it
     linear: float
     angular: float
 
 
 @dataclass(frozen=True)
 class OdomSample:
+    # time.time() when the robot measured it (the message stamp), so a busy test
+    # process that reads it late does not make the robot look slow.
     at: float
     x: float
     y: float
@@ -77,11 +79,20 @@ class Probe:
         self.node = node
 
     def _on_twist(self, msg: Any) -> None:
-        self.twists.append(TwistSample(time.monotonic(), msg.linear.x, msg.angular.z))
+        self.twists.append(TwistSample(time.time(), msg.linear.x, msg.angular.z))
 
     def _on_odom(self, msg: Any) -> None:
         p, t = msg.pose.pose.position, msg.twist.twist
-        self.odoms.append(OdomSample(time.monotonic(), p.x, p.y, t.linear.x, t.angular.z))
+        stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+        self.odoms.append(OdomSample(stamp, p.x, p.y, t.linear.x, t.angular.z))
+
+    def wait_for_publisher(self, topic: str, timeout: float = 20.0) -> None:
+        """Discovery is per pair of participants: the probe sees a new backend's
+        commands only once it has discovered that backend itself."""
+        deadline = time.monotonic() + timeout
+        while self.node.count_publishers(topic) == 0:
+            assert time.monotonic() < deadline, f"the probe never discovered a publisher on {topic}"
+            time.sleep(0.02)
 
     def publisher(self, msg_type: Any, topic: str) -> Any:
         return self.node.create_publisher(msg_type, topic, 10)
@@ -155,6 +166,7 @@ def robot(bridge: Bridge, probe: Probe, profile: Profile) -> Iterator[Ros2Robot]
     """A fresh backend on a freshly reset world: the robot at the origin, nothing held."""
     probe.reset_world()
     robot = Ros2Robot(profile, connect_timeout=30.0)
+    probe.wait_for_publisher("/cmd_vel")
     yield robot
     robot.close()
     assert bridge.process.poll() is None or bridge.process.returncode == 0, bridge.output()

@@ -1,0 +1,152 @@
+"""What goes wrong, through real DDS against `nrtrans sim-bridge` at real time:
+bad requests fail with reasons, and every way of stopping really stops the base."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+import signal
+import threading
+import time
+from collections.abc import Callable
+
+from agent.robot import CancelToken, Outcome, Status
+from agent.ros2.backend import Ros2Robot
+from agent.ros2.config import RosConfig
+from rsl.profile import Profile
+
+from .conftest import Bridge, Probe
+
+REALTIME_FACTOR = 1.0
+STOP_WITHIN = 0.2  # s, from the issue: the robot stops within 0.2 s of a cancel
+STILL = 0.01  # m/s
+
+
+def start_in_background(step: Callable[[], Outcome]) -> tuple[threading.Thread, list[Outcome]]:
+    result: list[Outcome] = []
+    thread = threading.Thread(target=lambda: result.append(step()), daemon=True)
+    thread.start()
+    return thread, result
+
+
+def wait_until_moving(probe: Probe, speed: float = 0.3, timeout: float = 10.0) -> None:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if probe.odoms and abs(probe.odoms[-1].linear) > speed:
+            return
+        time.sleep(0.01)
+    raise AssertionError(f"the base never reached {speed} m/s")
+
+
+def assert_stopped_after(probe: Probe, since: float, within: float) -> None:
+    """A zero Twist went out, no motion command followed it, and odometry shows the base
+    standing still within `within` seconds of `since` and staying still."""
+    twists = [t for t in probe.twists if t.at >= since]
+    zeros = [t for t in twists if t.linear == 0.0 and t.angular == 0.0]
+    assert zeros, "no zero Twist was sent"
+    assert zeros[0].at - since <= within, f"first zero Twist {zeros[0].at - since:.3f} s after"
+    moving_after = [t for t in twists if t.at > zeros[0].at and (t.linear or t.angular)]
+    assert not moving_after, f"motion commanded after the stop: {moving_after[:3]}"
+    odoms = [o for o in probe.odoms if o.at >= since]
+    still = [o for o in odoms if abs(o.linear) < STILL and abs(o.angular) < STILL]
+    assert still, "odometry never showed the base still"
+    assert still[0].at - since <= within, f"base still only {still[0].at - since:.3f} s after"
+    assert all(abs(o.linear) < STILL for o in odoms if o.at >= still[0].at), "the base moved again"
+
+
+def test_unknown_object_fails_with_the_known_ones_and_does_not_move(robot: Ros2Robot, probe: Probe) -> None:
+    outcome = robot.approach("unicorn")
+    assert outcome.status is Status.FAILED
+    assert "unknown object `unicorn`" in outcome.reason and "table" in outcome.reason
+    assert all(t.linear == 0.0 and t.angular == 0.0 for t in probe.twists)
+    assert math.hypot(robot.state().pose.x, robot.state().pose.y) < 0.01
+
+
+def test_grasp_out_of_reach_fails_with_the_distance(robot: Ros2Robot) -> None:
+    outcome = robot.grasp("cup")
+    assert outcome.status is Status.FAILED
+    assert "cup is 2.69 m away, out of reach 0.8 m" in outcome.reason
+    assert robot.state().holding is None
+
+
+def test_cancel_mid_motion_stops_the_base_within_0_2_s(robot: Ros2Robot, probe: Probe) -> None:
+    token = CancelToken()
+    thread, result = start_in_background(lambda: robot.forward(3.0, cancel=token))
+    wait_until_moving(probe)
+    cancelled_at = time.time()
+    token.set("operator said stop")
+    thread.join(5.0)
+    assert result == [Outcome.cancelled("operator said stop")]
+    time.sleep(0.6)
+    assert_stopped_after(probe, cancelled_at, STOP_WITHIN)
+    assert robot.state().pose.x < 2.0
+
+
+def test_emergency_stop_during_goto_stops_and_cancels_the_goal(robot: Ros2Robot, probe: Probe) -> None:
+    thread, result = start_in_background(lambda: robot.goto(-3.0, 0.0))
+    wait_until_moving(probe, speed=0.2)
+    stopped_at = time.time()
+    robot.stop()
+    thread.join(5.0)
+    assert result and result[0].status is Status.CANCELLED and "emergency stop" in result[0].reason
+    halted = robot.state().pose
+    time.sleep(1.0)
+    assert_stopped_after(probe, stopped_at, STOP_WITHIN)
+    after = robot.state().pose
+    assert math.hypot(after.x - halted.x, after.y - halted.y) < 0.01, "the goal kept driving the base"
+
+
+def test_lost_odometry_fails_the_step_and_stops_the_base(robot: Ros2Robot, probe: Probe, bridge: Bridge,
+                                                         profile: Profile) -> None:
+    thread, result = start_in_background(lambda: robot.forward(3.0))
+    wait_until_moving(probe)
+    os.kill(bridge.process.pid, signal.SIGSTOP)
+    paused_at = time.time()
+    try:
+        thread.join(5.0)
+        failed_at = time.time()
+    finally:
+        os.kill(bridge.process.pid, signal.SIGCONT)
+    limit = RosConfig.from_profile(profile).odom_timeout
+    assert result and result[0].status is Status.FAILED
+    assert "odometry on /odom is stale" in result[0].reason and "stopped" in result[0].reason
+    assert limit - 0.05 <= failed_at - paused_at <= limit + 1.0
+    zeros = [t for t in probe.twists if t.at >= paused_at + limit - 0.05 and not (t.linear or t.angular)]
+    assert zeros, "no zero Twist after the odometry went stale"
+    # The paused robot receives that zero when it wakes, and halts.
+    time.sleep(1.0)
+    assert probe.odoms and abs(probe.odoms[-1].linear) < STILL
+    nothing_moves = robot.forward(0.1)
+    assert nothing_moves.ok, "the link recovered, so the next step must work again"
+
+
+def test_malformed_object_reports_fail_with_a_clear_reason(bridge: Bridge, probe: Probe,
+                                                           profile: Profile) -> None:
+    from std_msgs.msg import String
+
+    probe.reset_world()
+    config = dataclasses.replace(RosConfig.from_profile(profile), objects_topic="/test/garbled_objects")
+    garbled = probe.publisher(String, config.objects_topic)
+    with Ros2Robot(profile, config=config, connect_timeout=30.0) as robot:
+        deadline = time.monotonic() + 5.0
+        outcome = robot.approach("cup")
+        while "malformed" not in outcome.reason and time.monotonic() < deadline:
+            garbled.publish(String(data="{not json"))
+            time.sleep(0.1)
+            outcome = robot.approach("cup")
+    assert outcome.status is Status.FAILED
+    assert "unknown object `cup`" in outcome.reason
+    assert "malformed" in outcome.reason and "not the documented JSON" in outcome.reason
+
+
+def test_a_missing_service_fails_the_step_instead_of_hanging(bridge: Bridge, probe: Probe,
+                                                              profile: Profile) -> None:
+    probe.reset_world()
+    config = dataclasses.replace(RosConfig.from_profile(profile), perceive_service="/nobody/perceive")
+    with Ros2Robot(profile, config=config, connect_timeout=30.0) as robot:
+        started = time.monotonic()
+        outcome = robot.perceive()
+    assert outcome.status is Status.FAILED
+    assert "service /nobody/perceive is not available" in outcome.reason
+    assert time.monotonic() - started < 5.0
