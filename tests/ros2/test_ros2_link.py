@@ -1,0 +1,68 @@
+"""The robot link itself: no robot at all, a robot that shuts down mid-task, and
+`nrtrans sim-bridge` refusing bad input. Each test owns its bridge process."""
+
+from __future__ import annotations
+
+import dataclasses
+import subprocess
+import sys
+import threading
+import time
+
+import pytest
+
+from agent.robot import Outcome, Status
+from agent.ros2.backend import RobotUnavailable, Ros2Robot
+from agent.ros2.config import RosConfig
+from rsl.profile import Profile
+
+from .conftest import REPO, ROS_ENV, Bridge
+
+pytestmark = pytest.mark.timeout(120)
+
+
+def test_no_robot_at_all_is_a_clear_error_not_a_hang(profile: Profile) -> None:
+    # Topics nobody serves: the same as a robot that is off or on another domain.
+    ros = {k: f"/absent{v}" for k, v in dataclasses.asdict(RosConfig()).items()
+           if isinstance(v, str) and v.startswith("/")}
+    config = dataclasses.replace(RosConfig.from_profile(profile), **ros)
+    started = time.monotonic()
+    with pytest.raises(RobotUnavailable) as error:
+        Ros2Robot(profile, config=config, connect_timeout=1.0)
+    assert time.monotonic() - started < 5.0
+    message = str(error.value)
+    assert "no odometry arrived on /absent/odom within 1 s" in message
+    assert "nrtrans sim-bridge" in message and "ROS_DOMAIN_ID" in message
+
+
+def test_robot_shutting_down_mid_motion_fails_the_step_and_exits_cleanly(profile: Profile) -> None:
+    bridge = Bridge(1.0)
+    try:
+        robot = Ros2Robot(profile, connect_timeout=30.0)
+        result: list[Outcome] = []
+        thread = threading.Thread(target=lambda: result.append(robot.forward(3.0)), daemon=True)
+        thread.start()
+        time.sleep(1.0)
+        assert bridge.terminate() == 0, bridge.output()
+        assert "sim-bridge: stopped" in bridge.output()
+        thread.join(5.0)
+        assert result and result[0].status is Status.FAILED
+        assert "stale" in result[0].reason
+        later = robot.turnleft(0.5)
+        assert later.status is Status.FAILED and "stale" in later.reason
+        robot.close()
+    finally:
+        bridge.kill()
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    (["--scene", "/nonexistent/scene.toml"], "cannot read scene file /nonexistent/scene.toml"),
+    (["--profile", "/nonexistent/robot.toml"], "cannot read robot profile /nonexistent/robot.toml"),
+    (["--realtime-factor", "0"], "--realtime-factor must be positive"),
+])
+def test_sim_bridge_rejects_bad_input_with_exit_2(args: list[str], message: str) -> None:
+    done = subprocess.run([sys.executable, "-m", "agent.cli", "sim-bridge", *args], cwd=REPO,
+                          env={**ROS_ENV, "PATH": "/usr/bin:/bin"}, capture_output=True, text=True,
+                          timeout=60)
+    assert done.returncode == 2, done.stderr
+    assert message in done.stderr
