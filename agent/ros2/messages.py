@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -47,8 +48,8 @@ class ObjectReport:
     footprints: dict[str, Footprint] = field(default_factory=dict)
 
 
-def encode_objects(objects: dict[str, tuple[float, ...]], held: str | None = None,
-                   frame: str = "odom", footprints: dict[str, Footprint] | None = None) -> str:
+def encode_objects(objects: Mapping[str, tuple[float, ...]], held: str | None = None,
+                   frame: str = "odom", footprints: Mapping[str, Footprint] | None = None) -> str:
     entries: dict[str, dict[str, object]] = {}
     for name, position in sorted(objects.items()):
         entry: dict[str, object] = {"x": round(position[0], 4), "y": round(position[1], 4)}
@@ -86,11 +87,11 @@ def decode_objects(text: str, where: str) -> ObjectReport:
     return ObjectReport(objects=objects, held=held or None, frame=str(frame), footprints=footprints)
 
 
-def _footprint(raw: object, where: str) -> Footprint:
+def _footprint(raw: Any, where: str) -> Footprint:
     try:
-        shape = raw["shape"]  # type: ignore[index]
-        sx, sy = (float(v) for v in raw["size"])  # type: ignore[index]
-        yaw = float(raw.get("yaw", 0.0))  # type: ignore[union-attr]
+        shape = raw["shape"]
+        sx, sy = (float(v) for v in raw["size"])
+        yaw = float(raw.get("yaw", 0.0))
     except (TypeError, KeyError, ValueError, AttributeError):
         raise FormatError(f"{where}: footprint must be {{\"shape\", \"size\": [x, y], \"yaw\"}}, "
                           f"got {raw!r}") from None
