@@ -6,12 +6,14 @@ import os
 import shlex
 import shutil
 import signal
+import socket
 import subprocess
 import time
 from pathlib import Path
 
 import pytest
 
+from agent.client import Client
 from models.store import model_dir
 from tests.daemon.conftest import NRTRANS, NotifyListener
 
@@ -112,3 +114,37 @@ def test_execstart_reports_ready_pings_the_watchdog_and_stops_cleanly(workdir: P
     assert not (runtime / "nrtrans.sock").exists(), "the socket file is removed on a clean stop"
     assert (state / "audit.jsonl").exists(), "the audit log goes in $STATE_DIRECTORY"
     print(f"start to READY=1: {ready - started:.2f} s")
+
+
+def test_socket_activation_serves_on_the_inherited_socket(workdir: Path) -> None:
+    """What nrtrans.socket does: systemd binds the socket and hands it over as fd 3."""
+    path = workdir / "activated.sock"
+    listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    listener.bind(str(path))
+    listener.listen(16)
+    config = workdir / "config.toml"
+    config.write_text(f'state_dir = "{workdir / "state"}"\n[speech]\nenabled = false\n[translator]\nwarmup = false\n')
+    notify = NotifyListener(workdir / "notify")
+    env = {**os.environ, "NOTIFY_SOCKET": str(workdir / "notify"), "LISTEN_FDS": "1"}
+    fd = listener.fileno()
+    # systemd sets LISTEN_PID to the service's pid: the shell's, which exec keeps.
+    command = ["/bin/sh", "-c", f'LISTEN_PID=$$ exec "{NRTRANS}" serve --config "{config}"']
+    with open(workdir / "log", "wb") as log:
+        # preexec_fn puts the listener at fd 3; listing 3 in pass_fds keeps it open across exec.
+        process = subprocess.Popen(
+            command, env=env, preexec_fn=lambda: os.dup2(fd, 3), pass_fds=(3, fd), stdout=subprocess.DEVNULL, stderr=log
+        )
+    listener.close()
+    try:
+        deadline = time.monotonic() + 180
+        while notify.wait_for("READY=1", 0.5) is None:
+            assert process.poll() is None and time.monotonic() < deadline, (workdir / "log").read_text()
+        with Client.connect(path, timeout=30) as client:
+            assert client.status()["state"] == "idle"
+        process.send_signal(signal.SIGTERM)
+        assert process.wait(60) == 0
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+        notify.close()
