@@ -166,11 +166,15 @@ class Ros2Robot:
 
     def stop(self) -> None:
         with self._publish_lock:
-            self._stops += 1
-            self._link.send_zero_twist()
-            odom = self._link.odometry()
-            if odom is not None:
-                self._link.send_goal(odom.pose.x, odom.pose.y, odom.pose.heading)
+            self._halt()
+
+    def _halt(self) -> None:
+        """Abort the step in progress and stop the base; the caller holds the publish lock."""
+        self._stops += 1
+        self._link.send_zero_twist()
+        odom = self._link.odometry()
+        if odom is not None:
+            self._link.send_goal(odom.pose.x, odom.pose.y, odom.pose.heading)
 
     def state(self) -> RobotState:
         odom = self._link.odometry()
@@ -191,13 +195,13 @@ class Ros2Robot:
     def close(self) -> None:
         if self._closed:
             return
-        self._closed = True
         with self._publish_lock:
-            self._stops += 1
-            self._link.send_zero_twist()
+            self._closed = True
+            self._halt()
         # Give DDS a moment to deliver the zero Twist before the participant goes away.
         time.sleep(0.05)
-        self._link.close()
+        with self._publish_lock:
+            self._link.close()
 
     def __enter__(self) -> Ros2Robot:
         return self

@@ -48,6 +48,7 @@ class RobotLink:
         from trajectory_msgs.msg import JointTrajectory
 
         self.config = config
+        self._closed = False
         self._lock = threading.Lock()
         self._odom_arrived = threading.Condition(self._lock)
         self._odom: Odometry | None = None
@@ -144,6 +145,8 @@ class RobotLink:
     # -- outgoing --------------------------------------------------------------
 
     def send_twist(self, linear: float, angular: float) -> None:
+        if self._closed:
+            return
         msg = self._twist_type()
         msg.linear.x = float(linear)
         msg.angular.z = float(angular)
@@ -155,6 +158,8 @@ class RobotLink:
             self.send_twist(0.0, 0.0)
 
     def send_goal(self, x: float, y: float, heading: float) -> None:
+        if self._closed:
+            return
         msg = self._pose_type()
         msg.header.frame_id = self.config.world_frame
         msg.header.stamp = self._ros.node.get_clock().now().to_msg()
@@ -177,6 +182,8 @@ class RobotLink:
         from builtin_interfaces.msg import Duration
         from trajectory_msgs.msg import JointTrajectoryPoint
 
+        if self._closed:
+            return
         msg = self._trajectory_type()
         msg.joint_names = joints
         point = JointTrajectoryPoint()
@@ -217,6 +224,9 @@ class RobotLink:
         return int(chosen.get_subscription_count())
 
     def close(self) -> None:
+        # After this, sends are no-ops: a step still unwinding in another thread
+        # must not publish through a destroyed node.
+        self._closed = True
         self._ros.close()
 
 

@@ -97,6 +97,19 @@ def test_emergency_stop_during_goto_stops_and_cancels_the_goal(robot: Ros2Robot,
     assert math.hypot(after.x - halted.x, after.y - halted.y) < 0.01, "the goal kept driving the base"
 
 
+def test_closing_the_backend_mid_motion_stops_the_base(robot: Ros2Robot, probe: Probe) -> None:
+    # What the daemon does on SIGTERM mid-task.
+    thread, result = start_in_background(lambda: robot.forward(3.0))
+    wait_until_moving(probe)
+    closed_at = time.time()
+    robot.close()
+    thread.join(5.0)
+    assert result and result[0].status is Status.CANCELLED
+    time.sleep(0.6)
+    assert_stopped_after(probe, closed_at, STOP_WITHIN)
+    assert robot.forward(0.1).status is Status.FAILED
+
+
 def test_lost_odometry_fails_the_step_and_stops_the_base(robot: Ros2Robot, probe: Probe, bridge: Bridge,
                                                          profile: Profile) -> None:
     thread, result = start_in_background(lambda: robot.forward(3.0))
