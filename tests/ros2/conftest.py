@@ -144,6 +144,13 @@ class Bridge:
         self.process.wait()
 
 
+@pytest.fixture(scope="module", autouse=True)
+def ros_environment() -> None:
+    """Re-assert the private domain before each module's nodes start, in case another
+    test area changed the environment since this file was imported."""
+    os.environ.update(ROS_ENV)
+
+
 @pytest.fixture(scope="module")
 def probe() -> Iterator[Probe]:
     probe = Probe()
