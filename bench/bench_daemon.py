@@ -50,13 +50,15 @@ TARGETS = {
 
 
 class Daemon:
-    def __init__(self, workdir: Path, realtime_factor: float) -> None:
+    def __init__(self, workdir: Path, realtime_factor: float, backend: str = "sim") -> None:
         self.workdir = workdir
+        workdir.mkdir(parents=True, exist_ok=True)
         self.socket = workdir / "api.sock"
         self.config = workdir / "config.toml"
         self.config.write_text(
             f'state_dir = "{workdir / "state"}"\nlog_level = "warning"\n'
             f'[api]\nsocket = "{self.socket}"\n[robot]\nrealtime_factor = {realtime_factor}\n'
+            f'backend = "{backend}"\n'
             "[speech]\nenabled = false\n"
         )
         self.process: subprocess.Popen[bytes] | None = None
@@ -102,11 +104,22 @@ def bench_starts(workdir: Path, count: int) -> list[float]:
     times = []
     for index in range(count):
         daemon = Daemon(workdir / f"start{index}", 0.0)
-        daemon.workdir.mkdir()
         times.append(daemon.start())
         daemon.stop()
         print(f"  start {index + 1}/{count}: READY=1 after {times[-1]:.2f} s", flush=True)
     return times
+
+
+def wait_warm(daemon: Daemon) -> float | None:
+    """The daemon's warm-up translation time, once it has finished (as a person would find it)."""
+    with Client.connect(daemon.socket, timeout=600) as client:
+        deadline = time.monotonic() + 600
+        while time.monotonic() < deadline:
+            warm = client.health()["components"]["translator"].get("warm_s")
+            if warm is not None:
+                return float(warm)
+            time.sleep(0.5)
+    return None
 
 
 def bench_tasks(daemon: Daemon, count: int) -> tuple[list[float], list[dict[str, Any]]]:
@@ -153,10 +166,79 @@ def bench_estop(daemon: Daemon, count: int) -> list[float]:
             times.append((time.perf_counter() - sent) * 1000)
             list(client.follow(task))
             operator.reset()
-            client.submit(rsl="backward 0.3;", follow=True)
-            for event in client.events():
-                if event["event"] in ("done", "failed", "cancelled", "rejected"):
-                    break
+            list(client.follow(client.submit(rsl="backward 0.3;", follow=True)))
+    return times
+
+
+def bench_estop_ros2(workdir: Path, count: int) -> list[float]:
+    """Daemon on the ROS 2 backend against `nrtrans sim-bridge`: estop sent -> zero Twist seen on cmd_vel.
+
+    The subscriber runs in this process over loopback DDS, so the figure includes one DDS hop (~0.3 ms).
+    """
+    os.environ.update(
+        {
+            "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
+            "ROS_DOMAIN_ID": str(100 + os.getpid() % 130),
+            "ROS_LOG_DIR": str(workdir / "ros-log"),
+        }
+    )
+    import threading
+
+    import rclpy
+    from geometry_msgs.msg import Twist
+    from rclpy.executors import SingleThreadedExecutor
+
+    from rsl.profile import load_profile
+
+    topic = load_profile().ros["cmd_vel"]
+    zero_at: list[float] = []
+    lock = threading.Lock()
+
+    def on_twist(msg: Twist) -> None:
+        if msg.linear.x == 0.0 and msg.angular.z == 0.0:
+            with lock:
+                zero_at.append(time.perf_counter())
+
+    bridge = subprocess.Popen([NRTRANS, "sim-bridge"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    rclpy.init()
+    node = rclpy.create_node("bench_daemon_estop")
+    node.create_subscription(Twist, topic, on_twist, 50)
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    spinner = threading.Thread(target=executor.spin, daemon=True)
+    spinner.start()
+    daemon = Daemon(workdir / "ros2", 1.0, backend="ros2")
+    times = []
+    try:
+        daemon.start()
+        with Client.connect(daemon.socket, timeout=60) as client, Client.connect(daemon.socket, timeout=60) as operator:
+            for _ in range(count):
+                task = client.submit(rsl="forward 3;", follow=True)
+                for event in client.events():
+                    if event["event"] == "executing" and event["task"] == task:
+                        break
+                time.sleep(0.5)
+                sent = time.perf_counter()
+                operator.estop("benchmark")
+                deadline = time.monotonic() + 2.0
+                while time.monotonic() < deadline:
+                    with lock:
+                        after = [t for t in zero_at if t >= sent]
+                    if after:
+                        times.append((after[0] - sent) * 1000)
+                        break
+                    time.sleep(0.001)
+                list(client.follow(task))
+                operator.reset()
+                list(client.follow(client.submit(rsl="backward 0.5;", follow=True)))
+    finally:
+        if daemon.process is not None:
+            daemon.stop()
+        executor.shutdown()
+        node.destroy_node()
+        rclpy.shutdown()
+        bridge.send_signal(signal.SIGTERM)
+        bridge.wait(30)
     return times
 
 
@@ -165,6 +247,11 @@ def main() -> int:
     parser.add_argument("--starts", type=int, default=3, help="daemon starts to time (default 3)")
     parser.add_argument("--tasks", type=int, default=6, help="text tasks to time (default 6)")
     parser.add_argument("--estops", type=int, default=10, help="emergency stops to time (default 10)")
+    parser.add_argument(
+        "--ros2",
+        action="store_true",
+        help="also time estop -> zero Twist on cmd_vel with the ROS 2 backend and sim-bridge",
+    )
     parser.add_argument("--out", type=Path, default=ROOT / "bench" / "results" / "daemon.json")
     args = parser.parse_args()
 
@@ -173,15 +260,20 @@ def main() -> int:
         print("start to READY=1 ...", flush=True)
         starts = bench_starts(workdir, args.starts)
         main_daemon = Daemon(workdir / "main", 1.0)
-        main_daemon.workdir.mkdir()
         main_daemon.start()
         rss_ready = main_daemon.rss_mb()
+        warm_s = wait_warm(main_daemon)
+        print(f"  translator warm-up after READY took {warm_s} s", flush=True)
         print("submit to first robot command (embedded model) ...", flush=True)
         firsts, records = bench_tasks(main_daemon, args.tasks)
         rss_after = main_daemon.rss_mb()
         print("estop to zero velocity ...", flush=True)
         estops = bench_estop(main_daemon, args.estops)
         main_daemon.stop()
+        estops_ros2: list[float] = []
+        if args.ros2:
+            print("estop to zero Twist on cmd_vel (ROS 2 backend, sim-bridge) ...", flush=True)
+            estops_ros2 = bench_estop_ros2(workdir, args.estops)
     finally:
         shutil.rmtree(workdir, ignore_errors=True)
 
@@ -196,12 +288,19 @@ def main() -> int:
         "medians": {
             "start_to_ready_s": round(median(starts), 3),
             "submit_to_first_command_p50_s": round(median(firsts), 3),
+            "warmup_after_ready_s": warm_s,
             "rss_mb_ready": round(rss_ready, 1),
             "rss_mb_after_tasks": round(rss_after, 1),
             "estop_to_zero_velocity_ms": round(median(estops), 3),
+            "estop_to_zero_twist_ros2_ms": round(median(estops_ros2), 3) if estops_ros2 else None,
         },
         "targets": TARGETS,
-        "samples": {"start_to_ready_s": starts, "submit_to_first_command_s": firsts, "estop_ms": estops},
+        "samples": {
+            "start_to_ready_s": starts,
+            "submit_to_first_command_s": firsts,
+            "estop_ms": estops,
+            "estop_ros2_ms": estops_ros2,
+        },
         "tasks": records,
         "method": {
             "start_to_ready_s": "spawn of `nrtrans serve` to READY=1 on a notify socket owned by the benchmark",
