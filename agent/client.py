@@ -181,3 +181,38 @@ class Client:
         if not isinstance(frame, dict):
             raise ClientError(f"the daemon sent a frame that is not an object: {line[:80]!r}")
         return frame
+
+
+def describe_event(event: dict[str, Any]) -> str:
+    """One human-readable line for an event frame (what `nrtrans send` and `events` print)."""
+    name = event["event"]
+    prefix = f"[{event['task']}]" if event.get("task") else "[daemon]"
+    if name == "queued":
+        detail = f"position {event['position']} in the queue"
+    elif name in ("heard", "translating"):
+        detail = repr(event["text"])
+    elif name == "attempt":
+        errors = event["diagnostics"]
+        verdict = (
+            "ok"
+            if not errors
+            else f"{len(errors)} error(s): " + "; ".join(f"line {d.get('line')}: {d.get('message')}" for d in errors)
+        )
+        detail = f"{event['pass']}: {event['program'].strip()!r} ({verdict})"
+    elif name == "verified":
+        detail = event["program"].strip().replace("\n", " ")
+    elif name == "executing":
+        detail = f"step {event['step']}/{event['total']}: {event['statement']}"
+    elif name == "step":
+        outcome = event["outcome"]
+        detail = f"{event['step']}/{event['total']} {outcome['status']}"
+        if outcome.get("reason"):
+            detail += f" ({outcome['reason']})"
+    elif name == "done":
+        pose = (event.get("state") or {}).get("pose")
+        detail = f"pose x={pose['x']:.2f} y={pose['y']:.2f} heading={pose['heading']:.2f}" if pose else ""
+    elif name == "speech":
+        detail = str(event.get("state", ""))
+    else:
+        detail = str(event.get("reason", ""))
+    return f"{prefix} {name} {detail}".rstrip()

@@ -256,37 +256,6 @@ def _describe_record(record: dict[str, Any], *, detailed: bool) -> str:
 
 
 def _print_event(event: dict[str, Any], raw: bool) -> None:
-    if raw:
-        print(json.dumps(event), flush=True)
-        return
-    name = event["event"]
-    prefix = f"[{event['task']}]" if event.get("task") else "[daemon]"
-    if name == "queued":
-        detail = f"position {event['position']} in the queue"
-    elif name in ("heard", "translating"):
-        detail = repr(event["text"])
-    elif name == "attempt":
-        errors = event["diagnostics"]
-        verdict = (
-            "ok"
-            if not errors
-            else f"{len(errors)} error(s): " + "; ".join(f"line {d.get('line')}: {d.get('message')}" for d in errors)
-        )
-        detail = f"{event['pass']}: {event['program'].strip()!r} ({verdict})"
-    elif name == "verified":
-        detail = event["program"].strip().replace("\n", " ")
-    elif name == "executing":
-        detail = f"step {event['step']}/{event['total']}: {event['statement']}"
-    elif name == "step":
-        outcome = event["outcome"]
-        detail = f"step {event['step']}/{event['total']} {outcome['status']}"
-        if outcome.get("reason"):
-            detail += f" ({outcome['reason']})"
-    elif name == "done":
-        pose = (event.get("state") or {}).get("pose")
-        detail = f"pose x={pose['x']:.2f} y={pose['y']:.2f} heading={pose['heading']:.2f}" if pose else ""
-    elif name == "speech":
-        detail = event.get("state", "")
-    else:
-        detail = event.get("reason", "")
-    print(f"{prefix} {name} {detail}".rstrip(), flush=True)
+    from agent.client import describe_event
+
+    print(json.dumps(event) if raw else describe_event(event), flush=True)
