@@ -32,7 +32,7 @@ from rsl.profile import Profile
 CONTROL_PERIOD = 0.02  # s, 50 Hz: well inside the 0.2 s the robot has to stop after a cancel
 LINEAR_TOLERANCE = 0.002  # m; the contract is 2 cm, the rest is margin for coasting
 ANGULAR_TOLERANCE = math.radians(0.15)  # the contract is 1 degree
-GOAL_TOLERANCE = 0.03  # m, for goal poses, which the robot's own controller settles
+GOAL_GIVE_UP = 2.0  # s standing still short of a goal, after moving, before the step fails
 GOAL_HEADING_TOLERANCE = math.radians(2.0)
 JOINT_TOLERANCE = 0.01  # rad, or m for the gripper
 STILL_LINEAR = 0.01  # m/s; slower than this counts as standing still
@@ -94,7 +94,7 @@ class Ros2Robot:
             self._check_workspace(x, y, f"goto {x:g}, {y:g}")
             start = self._fresh_odometry().pose
             far = math.hypot(x - start.x, y - start.y)
-            heading = math.atan2(y - start.y, x - start.x) if far > GOAL_TOLERANCE else start.heading
+            heading = math.atan2(y - start.y, x - start.x) if far > self.config.goal_tolerance else start.heading
             self._drive_to_goal(x, y, heading, token, check_heading=False)
             return Outcome.done()
         return self._guarded(cancel, run)
@@ -310,19 +310,32 @@ class Ros2Robot:
         with self._publish_lock:
             self._check_interrupts(token)
             self._link.send_goal(x, y, heading)
-        reached = False
+        reached = moved = False
+        still_since = math.inf
+        tolerance = self.config.goal_tolerance
         try:
             while True:
                 self._check_interrupts(token)
                 odom = self._fresh_odometry()
+                now = time.monotonic()
                 off = math.hypot(x - odom.pose.x, y - odom.pose.y)
                 turned = abs(wrap_angle(heading - odom.pose.heading))
                 still = abs(odom.linear) < STILL_LINEAR and abs(odom.angular) < STILL_ANGULAR
                 facing = not check_heading or turned <= GOAL_HEADING_TOLERANCE
-                if off <= GOAL_TOLERANCE and still and facing:
+                if off <= tolerance and still and facing:
                     reached = True
                     return
-                if time.monotonic() > deadline:
+                moved = moved or not still
+                still_since = min(still_since, now) if still else math.inf
+                if moved and now - still_since > GOAL_GIVE_UP:
+                    # The navigation stack has settled short of the goal: say so now
+                    # rather than at the timeout.
+                    raise StepFailure(f"the robot stopped {off:.2f} m from ({x:.2f}, {y:.2f}), "
+                                      f"{math.degrees(turned):.0f} degrees off the goal heading; the goal "
+                                      f"tolerance is {tolerance:g} m. Is the path blocked, or is the "
+                                      "navigation stack's own goal tolerance larger than the profile's "
+                                      "[ros] goal_tolerance?")
+                if now > deadline:
                     raise StepFailure(f"did not reach ({x:.2f}, {y:.2f}) within {budget:.1f} s; "
                                       f"stopped {off:.2f} m from it. Is the path blocked?")
                 token.wait(CONTROL_PERIOD)

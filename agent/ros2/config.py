@@ -32,6 +32,9 @@ class RosConfig:
     gripper_closed_position: float = 0.0
     # The frame goal poses are given in; odometry's frame on the robots we target.
     world_frame: str = "odom"
+    # Metres from a goal pose that count as arrived; at least the navigation stack's own
+    # goal tolerance (Nav2's xy_goal_tolerance), or goals end as failures.
+    goal_tolerance: float = 0.03
     # Seconds without odometry before a moving base is stopped and the step fails.
     odom_timeout: float = 0.5
     # Seconds to wait for the robot's first odometry before giving up on the link.
@@ -60,6 +63,8 @@ class RosConfig:
                     raise ProfileError(f"{source}: [ros] {key} must be a number, got {value!r}")
                 if key.endswith("_timeout") and value <= 0:
                     raise ProfileError(f"{source}: [ros] {key} must be a positive number of seconds")
+                if key == "goal_tolerance" and value <= 0:
+                    raise ProfileError(f"{source}: [ros] goal_tolerance must be a positive number of metres")
                 values[key] = float(value)
             else:
                 if not isinstance(value, str) or not value:

@@ -163,3 +163,18 @@ def test_a_missing_service_fails_the_step_instead_of_hanging(bridge: Bridge, pro
     assert outcome.status is Status.FAILED
     assert "service /nobody/perceive is not available" in outcome.reason
     assert time.monotonic() - started < 5.0
+
+
+def test_a_goal_the_robot_settles_short_of_fails_without_waiting_for_the_timeout(
+        bridge: Bridge, probe: Probe, profile: Profile) -> None:
+    # The bridge's follower settles within 1 cm; a profile demanding 1 mm stands for a
+    # navigation stack whose own goal tolerance is coarser than the profile's.
+    probe.reset_world()
+    config = dataclasses.replace(RosConfig.from_profile(profile), goal_tolerance=0.001)
+    with Ros2Robot(profile, config=config, connect_timeout=30.0) as robot:
+        started = time.monotonic()
+        outcome = robot.goto(0.5, 0.0)
+        took = time.monotonic() - started
+    assert outcome.status is Status.FAILED
+    assert "the robot stopped 0.0" in outcome.reason and "goal_tolerance" in outcome.reason
+    assert took < 8.0, f"took {took:.1f} s: it waited for the timeout"
