@@ -323,18 +323,16 @@ class Service:
     def _run(self, task: Task) -> None:
         start = time.monotonic()
         self.on_status(f"task {task.id}: {task.text or 'RSL program'}")
-        known = self._known_objects()
-        if task.cancel.is_set():
-            self._finish(task, TaskState.CANCELLED, task.cancel.reason)
+        if self._halted(task):
             return
+        known = self._known_objects()
         plan = self._translate(task, known, start) if task.text is not None else self._compile(task, known, start)
         if plan is None:
             return
         task.program = plan.to_rsl()
         task.plan = plan.to_list()
         self.events.publish("verified", task.id, program=task.program, plan=task.plan)
-        if task.cancel.is_set():
-            self._finish(task, TaskState.CANCELLED, task.cancel.reason)
+        if self._halted(task):
             return
         task.state = TaskState.EXECUTING
         # The plan is on disk before the first command reaches the robot.
@@ -430,6 +428,18 @@ class Service:
             self._finish(task, TaskState.FAILED, _last_reason(result) or "a step failed", robot_state=final_state)
 
     # -- helpers ---------------------------------------------------------------------------
+
+    def _halted(self, task: Task) -> bool:
+        """Finish `task` as cancelled if it was cancelled or an emergency stop is latched."""
+        with self._lock:
+            latched = self._estop_reason
+        if latched is not None and not task.cancel.is_set():
+            # Taken off the queue in the instant the emergency stop drained it.
+            task.cancel.set(f"emergency stop: {latched}")
+        if not task.cancel.is_set():
+            return False
+        self._finish(task, TaskState.CANCELLED, task.cancel.reason)
+        return True
 
     def _reject(self, task: Task, reason: str, diagnostics: list[dict[str, Any]]) -> None:
         with self._lock:
