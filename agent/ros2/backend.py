@@ -177,20 +177,34 @@ class Ros2Robot:
             self._link.send_goal(odom.pose.x, odom.pose.y, odom.pose.heading)
 
     def state(self) -> RobotState:
+        """Pose from odometry, head from joint states, and as known objects everything the
+        robot reports on its objects topic plus what `perceive` has seen."""
         odom = self._link.odometry()
         pose = odom.pose if odom is not None else Pose(0.0, 0.0, 0.0)
         joints, _ = self._link.joints()
         report, _ = self._link.objects()
+        known = dict(self._known)
         if report is not None:
-            for name in self._known.keys() & report.objects.keys():
-                self._known[name] = report.objects[name]
+            known.update(report.objects)
         return RobotState(
             pose=pose,
             head_pan=joints.get(self.config.head_pan_joint, 0.0),
             head_tilt=joints.get(self.config.head_tilt_joint, 0.0),
             holding=self._holding_now(),
-            known_objects=tuple((n, x, y) for n, (x, y) in sorted(self._known.items())),
+            known_objects=tuple((n, x, y) for n, (x, y) in sorted(known.items())),
         )
+
+    def __getattr__(self, name: str) -> Callable[..., Outcome]:
+        # A skill added to the profile but not taught to this backend fails as a step
+        # with a reason, rather than crashing the executor with an AttributeError.
+        profile = self.__dict__.get("profile")
+        if profile is None or profile.skill(name) is None:
+            raise AttributeError(name)
+
+        def unsupported(*_args: object, cancel: CancelToken | None = None) -> Outcome:
+            return Outcome.failed(f"the ROS 2 backend has no implementation of the skill `{name}` "
+                                  f"from profile {profile.name}; add it to agent/ros2/backend.py")
+        return unsupported
 
     def close(self) -> None:
         if self._closed:

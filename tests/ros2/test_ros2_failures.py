@@ -10,6 +10,7 @@ import signal
 import threading
 import time
 from collections.abc import Callable
+from pathlib import Path
 
 from agent.robot import CancelToken, Outcome, Status
 from agent.ros2.backend import Ros2Robot
@@ -178,3 +179,17 @@ def test_a_goal_the_robot_settles_short_of_fails_without_waiting_for_the_timeout
     assert outcome.status is Status.FAILED
     assert "the robot stopped 0.0" in outcome.reason and "goal_tolerance" in outcome.reason
     assert took < 8.0, f"took {took:.1f} s: it waited for the timeout"
+
+
+def test_a_profile_skill_the_backend_lacks_fails_as_a_step(bridge: Bridge, probe: Probe,
+                                                            profile: Profile) -> None:
+    from rsl.profile import parse_profile
+
+    extra = '\n[[skills]]\nkeyword = "wave"\ndescription = "Wave."\nexample = "wave;"\nparams = []\n'
+    waving = parse_profile(Path(profile.source).read_text(encoding="utf-8") + extra, source="waving.toml")
+    probe.reset_world()
+    with Ros2Robot(waving, connect_timeout=30.0) as robot:
+        outcome = robot.wave(cancel=CancelToken())  # type: ignore[attr-defined]
+        assert not hasattr(robot, "dance")
+    assert outcome.status is Status.FAILED
+    assert "no implementation of the skill `wave`" in outcome.reason

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import pytest
 
-from agent.robot import CancelToken, RobotState
+from agent.robot import CancelToken, Outcome, RobotState
 from agent.ros2.backend import Ros2Robot
 from rsl.compiler import compile_program
 from rsl.plan import ObjectRef
@@ -38,20 +38,22 @@ SCENARIOS = [
 ]
 
 
-def run_program(robot: Ros2Robot, profile: Profile, program: str) -> RobotState:
+def run_program(robot: Ros2Robot, profile: Profile, program: str) -> tuple[RobotState, list[Outcome]]:
     result = compile_program(program, profile)
     assert result.ok, [d.brief() for d in result.diagnostics]
     assert result.plan is not None
+    outcomes = []
     for command in result.plan:
         args = [a.name if isinstance(a, ObjectRef) else a.value for a in command.args]
         outcome = getattr(robot, command.skill)(*args, cancel=CancelToken())
         assert outcome.ok, f"`{command.to_rsl()}` {outcome.status.value}: {outcome.reason}"
-    return robot.state()
+        outcomes.append(outcome)
+    return robot.state(), outcomes
 
 
 @pytest.mark.parametrize("scenario", SCENARIOS, ids=lambda s: s.name)
 def test_scenario_ends_where_expected(scenario: Scenario, robot: Ros2Robot, profile: Profile) -> None:
-    state = run_program(robot, profile, scenario.program)
+    state, outcomes = run_program(robot, profile, scenario.program)
     x, y, heading = scenario.pose
     assert math.hypot(state.pose.x - x, state.pose.y - y) < 0.05, state.pose
     if heading is not None:
@@ -59,8 +61,9 @@ def test_scenario_ends_where_expected(scenario: Scenario, robot: Ros2Robot, prof
         assert off < math.radians(2.0), state.pose
     assert state.holding == scenario.holding
     assert abs(state.head_pan) < 0.03 and abs(state.head_tilt) < 0.03
-    known = {name for name, _x, _y in state.known_objects}
-    assert set(scenario.seen) <= known, known
+    seen = {name.strip() for o in outcomes if o.reason.startswith("saw ")
+            for name in o.reason.removeprefix("saw ").split(",")}
+    assert set(scenario.seen) <= seen, seen
 
 
 def test_each_straight_move_and_turn_is_within_2cm_and_1_degree(robot: Ros2Robot) -> None:
