@@ -84,6 +84,11 @@ def register(subparsers: Any) -> None:
         _history,
     )
     history.add_argument("-n", "--limit", type=int, default=20, help="how many tasks (default 20, max 1000)")
+    history.add_argument(
+        "--audit",
+        metavar="FILE",
+        help="read this audit log file directly (e.g. while the daemon is stopped) instead of asking the daemon",
+    )
     add(
         "listen",
         "push-to-talk: start listening for a spoken task now",
@@ -211,17 +216,33 @@ def _health(args: argparse.Namespace) -> int:
 
 
 def _history(args: argparse.Namespace) -> int:
-    def action(client: Any) -> int:
-        records = client.history(max(1, min(args.limit, 1000)))
-        if args.json:
-            print(json.dumps(records, indent=2))
-        elif not records:
-            print("no tasks recorded yet")
-        for record in [] if args.json else records:
-            print(_describe_record(record, detailed=False))
-        return 0
+    limit = max(1, min(args.limit, 1000))
 
+    def action(client: Any) -> int:
+        return _show_history(client.history(limit), args.json)
+
+    if args.audit:
+        from pathlib import Path
+
+        from agent.daemon.audit import AuditLog
+
+        path = Path(args.audit)
+        if not path.is_file():
+            print(f"nrtrans history: error: no audit log at {path}", file=sys.stderr)
+            return EXIT_NO_DAEMON
+        return _show_history(AuditLog(path).recent(limit), args.json)
     return _call(args, action)
+
+
+def _show_history(records: list[dict[str, Any]], raw: bool) -> int:
+    if raw:
+        print(json.dumps(records, indent=2))
+    elif not records:
+        print("no tasks recorded yet")
+    else:
+        for record in records:
+            print(_describe_record(record, detailed=False))
+    return 0
 
 
 def _listen(args: argparse.Namespace) -> int:

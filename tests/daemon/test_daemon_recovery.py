@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import json
 import signal
+import subprocess
 import time
 from pathlib import Path
 
 import pytest
 
 from agent.client import RequestFailed
-from tests.daemon.conftest import Daemon, check_frame
+from tests.daemon.conftest import NRTRANS, Daemon, check_frame
 
 
 def _wait_executing(daemon: Daemon, task: str) -> None:
@@ -34,6 +35,11 @@ def test_sigkill_mid_task_then_restart_marks_it_interrupted_and_never_replays(wo
     lines = [json.loads(line) for line in before.splitlines()]
     assert lines[-1]["task"] == task and lines[-1]["state"] == "executing" and not lines[-1]["final"]
     assert lines[-1]["plan"], "the plan was on disk before the robot moved"
+
+    offline = subprocess.run(
+        [NRTRANS, "history", "--audit", str(audit), "--json"], capture_output=True, text=True, timeout=60, check=True
+    )
+    assert json.loads(offline.stdout)[-1]["state"] == "executing", "readable while the daemon is down"
 
     restarted = Daemon(workdir).start()
     try:
