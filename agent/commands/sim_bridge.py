@@ -31,6 +31,11 @@ def register(subparsers: Any) -> None:
 
 
 def _run(args: argparse.Namespace) -> int:
+    # Installed first, so a SIGTERM during the slow imports still ends in a clean exit 0.
+    stop = threading.Event()
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, lambda *_: stop.set())
+
     from agent.sim.scene import SceneError, load_scene
     from rsl.profile import ProfileError, load_profile
 
@@ -59,9 +64,6 @@ def _run(args: argparse.Namespace) -> int:
     from agent.ros2.bridge import SimBridge
     from agent.sim.world import SimWorld
 
-    stop = threading.Event()
-    for signum in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(signum, lambda *_: stop.set())
     print(f"sim-bridge: loading scene `{scene.name}` ({len(scene.objects)} objects)", file=sys.stderr, flush=True)
     bridge = SimBridge(profile, lambda: SimWorld(profile, scene), realtime_factor=args.realtime_factor,
                        config=config)
