@@ -460,7 +460,7 @@ class Ros2Robot:
     def _object_position(self, name: str) -> tuple[float, float]:
         report, error = self._link.objects()
         deadline = time.monotonic() + FIRST_MESSAGE_WAIT
-        while report is None and name not in self._known and time.monotonic() < deadline:
+        while report is None and not error and name not in self._known and time.monotonic() < deadline:
             # Just connected: the objects topic repeats, so its next message is near.
             time.sleep(0.05)
             report, error = self._link.objects()
