@@ -25,7 +25,7 @@ from agent.robot import CancelToken, Outcome, Pose, RobotState
 from agent.ros2.config import RosConfig
 from agent.ros2.geometry import footprint_radius, wrap_angle
 from agent.ros2.link import Odometry, RobotLink, ServiceError
-from agent.ros2.messages import FormatError, decode_held, decode_objects
+from agent.ros2.messages import Footprint, FormatError, decode_held, decode_objects
 from agent.ros2.motion import Limits, move_budget, next_speed
 from rsl.profile import Profile
 
@@ -58,6 +58,7 @@ class Ros2Robot:
         self._linear = Limits(motion.max_linear_speed, motion.max_linear_accel, gain=3.0, creep=0.02)
         self._angular = Limits(motion.max_angular_speed, motion.max_angular_accel, gain=3.0, creep=0.03)
         self._known: dict[str, tuple[float, float]] = {}
+        self._footprints: dict[str, Footprint] = {}
         self._holding: str | None = None
         self._held_since = 0.0
         self._stops = 0
@@ -131,8 +132,10 @@ class Ros2Robot:
             reply = self._link.call_perceive(token)
             if not reply.success:
                 raise StepFailure(f"perception failed: {reply.message}")
-            seen = decode_objects(reply.message, f"reply of {self.config.perceive_service}").objects
+            report = decode_objects(reply.message, f"reply of {self.config.perceive_service}")
+            seen = report.objects
             self._known.update(seen)
+            self._footprints.update(report.footprints)
             if not seen:
                 return Outcome.done("saw no objects")
             return Outcome.done("saw " + ", ".join(sorted(seen)))
@@ -477,6 +480,7 @@ class Ros2Robot:
         """How far the object's edge is from its centre, seen from `direction`; 0 if unknown."""
         report, _ = self._link.objects()
         footprint = report.footprints.get(name) if report is not None else None
+        footprint = footprint or self._footprints.get(name)
         if footprint is None:
             return 0.0
         return footprint_radius(footprint.shape, footprint.size, footprint.yaw, direction)

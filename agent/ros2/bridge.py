@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Iterable
 from typing import Any
 
 from agent.ros2.config import RosConfig
@@ -71,6 +72,7 @@ class SimBridge:
         self._timer = node.create_timer(1.0 / PUBLISH_HZ, self._tick)
 
     def _reset_state(self) -> None:
+        self._seen: set[str] = set()
         self._cmd = (0.0, 0.0)
         self._cmd_at = -math.inf
         self._follower.clear()
@@ -132,9 +134,11 @@ class SimBridge:
         self._joints.publish(joints)
 
     def _publish_objects(self) -> None:
-        scene = self.world.scene
-        footprints = {o.name: Footprint(o.shape, (o.size[0], o.size[1]), o.yaw) for o in scene.objects}
-        text = encode_objects(self.world.objects(), self.world.holding, self.config.world_frame, footprints)
+        # Like a perception stack's tracker: the objects seen so far, where they are now.
+        world = self.world
+        tracked = {name: position for name, position in world.objects().items()
+                   if name in self._seen or name == world.holding}
+        text = encode_objects(tracked, world.holding, self.config.world_frame, self._footprints(tracked))
         self._objects.publish(self._string_type(data=text))
 
     # -- commands ----------------------------------------------------------------------
@@ -186,9 +190,17 @@ class SimBridge:
 
     def _on_perceive(self, _request: Any, response: Any) -> Any:
         seen = self.world.visible_objects()
+        self._seen.update(seen)
         response.success = True
-        response.message = encode_objects(seen, frame=self.config.world_frame)
+        response.message = encode_objects(seen, frame=self.config.world_frame,
+                                          footprints=self._footprints(seen))
+        self._publish_objects()
         return response
+
+    def _footprints(self, names: Iterable[str]) -> dict[str, Footprint]:
+        wanted = set(names)
+        return {o.name: Footprint(o.shape, (o.size[0], o.size[1]), o.yaw)
+                for o in self.world.scene.objects if o.name in wanted}
 
     def _on_grasp(self, _request: Any, response: Any) -> Any:
         world = self.world
@@ -199,12 +211,14 @@ class SimBridge:
             obj = world.scene.object(name)
             away = math.hypot(x - pose.x, y - pose.y)
             bearing = abs(wrap_angle(math.atan2(y - pose.y, x - pose.x) - pose.heading))
-            if obj is not None and obj.graspable and name != world.holding and away <= reach \
-                    and bearing <= GRASP_BEARING:
+            # The arm is guided by perception, so it only reaches for objects seen before.
+            if obj is not None and obj.graspable and name in self._seen and name != world.holding \
+                    and away <= reach and bearing <= GRASP_BEARING:
                 candidates.append((away, name))
         if not candidates:
             response.success = False
-            response.message = f"no graspable object within reach {reach:g} m in front of the gripper"
+            response.message = (f"no graspable object seen so far is within reach {reach:g} m "
+                                "in front of the gripper")
             return response
         name = min(candidates)[1]
         outcome = world.grasp(name)

@@ -12,8 +12,8 @@ functions, so the two sides cannot drift apart.
   (shape box, cylinder or sphere), so `approach` keeps its stand-off from the
   object's edge rather than its centre.
 - perceive service (std_srvs/Trigger), on success the response message is
-  `{"frame": "odom", "objects": {"cup": {"x": 1.0, "y": 0.5}}}` (the objects in view);
-  on failure it is a sentence saying why.
+  `{"frame": "odom", "objects": {"cup": {"x": 1.0, "y": 0.5}}}` (the objects in view,
+  footprints optional as above); on failure it is a sentence saying why.
 - grasp service (std_srvs/Trigger) picks up the object nearest the gripper;
   on success the message is `{"held": "cup"}`, on failure a sentence saying why.
 """

@@ -57,6 +57,8 @@ def assert_stopped_after(probe: Probe, since: float, within: float) -> None:
 
 
 def test_unknown_object_fails_with_the_known_ones_and_does_not_move(robot: Ros2Robot, probe: Probe) -> None:
+    assert robot.approach("table").reason.startswith("unknown object `table`: no objects are known yet")
+    assert robot.perceive().ok
     outcome = robot.approach("unicorn")
     assert outcome.status is Status.FAILED
     assert "unknown object `unicorn`" in outcome.reason and "table" in outcome.reason
@@ -65,6 +67,7 @@ def test_unknown_object_fails_with_the_known_ones_and_does_not_move(robot: Ros2R
 
 
 def test_grasp_out_of_reach_fails_with_the_distance(robot: Ros2Robot) -> None:
+    assert robot.perceive().ok
     outcome = robot.grasp("cup")
     assert outcome.status is Status.FAILED
     assert "cup is 2.69 m away, out of reach 0.8 m" in outcome.reason

@@ -31,7 +31,8 @@ SCENARIOS = [
                             "forward 1; turnleft 1.5708; forward 1; turnleft 1.5708;", (0.0, 0.0, 0.0)),
     Scenario("square_right_backward", "backward 0.5; turnright 1.5708; forward 0.5; turnright 1.5708; "
                                       "forward 0.5;", (-1.0, -0.5, math.pi)),
-    Scenario("approach_then_grasp", "approach table; grasp cup;", (2.1, 0.0, 0.0), holding="cup"),
+    Scenario("approach_then_grasp", "perceive; approach table; grasp cup;", (2.1, 0.0, 0.0), holding="cup",
+             seen=("table", "cup", "bottle")),
     Scenario("look_around", "lookdown 0.3; lookleft 1.5708; perceive; lookright 3.1416; perceive; "
                             "lookleft 1.5708; lookup 0.3;", (0.0, 0.0, 0.0), seen=("ball", "book", "banana")),
     Scenario("goto_and_back", "goto 1.5, -1; goto 0, 0;", (0.0, 0.0, None)),  # type: ignore[arg-type]
