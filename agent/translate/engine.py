@@ -35,37 +35,45 @@ class Generation:
     finished: bool  # False when the token cap cut it off
 
 
-def open_llama(path: Path, *, n_ctx: int = 2048, lora_path: Path | None = None, n_threads: int | None = None
-               ) -> Any:
-    """Load a GGUF model; `lora_path` applies an adapter.
+def use_plain_cpu_buffers() -> None:
+    """Make every later `llama_cpp.Llama` in this process load plain CPU weight buffers.
 
     llama.cpp's repacked CPU weight buffers (AMX on this class of Xeon) crash
-    in decode, so the plain buffers are used; they are just as fast for a
-    model this small.
+    in decode, so nrtrans loads models without them; for a model this small
+    the plain buffers are as fast. Processes that only serve a model (the
+    loopback llama_cpp.server in the tests) call this before loading.
     """
     import llama_cpp
     import llama_cpp.llama as llama_module
 
-    if n_threads is None:
-        # All cores of the small robot computer; NRTRANS_THREADS overrides it
-        # where other work shares them (spinning llama.cpp threads that lose
-        # their core make decoding slower, not faster).
-        n_threads = int(os.environ.get("NRTRANS_THREADS", "0")) or min(4, os.cpu_count() or 1)
     with _OPEN_LOCK:
-        original = llama_module.llama_cpp.llama_model_default_params
+        current = llama_module.llama_cpp.llama_model_default_params
+        if getattr(current, "plain_buffers", False):
+            return
+        original = llama_cpp.llama_model_default_params
 
         def plain_buffers() -> Any:
             params = original()
             params.use_extra_bufts = False
             return params
 
+        plain_buffers.plain_buffers = True  # type: ignore[attr-defined]
         llama_module.llama_cpp.llama_model_default_params = plain_buffers
-        try:
-            return llama_cpp.Llama(model_path=str(path), n_ctx=n_ctx, n_batch=512, verbose=False,
-                                   lora_path=None if lora_path is None else str(lora_path),
-                                   n_threads=n_threads)
-        finally:
-            llama_module.llama_cpp.llama_model_default_params = original
+
+
+def open_llama(path: Path, *, n_ctx: int = 2048, lora_path: Path | None = None, n_threads: int | None = None
+               ) -> Any:
+    """Load a GGUF model; `lora_path` applies an adapter."""
+    import llama_cpp
+
+    if n_threads is None:
+        # All cores of the small robot computer; NRTRANS_THREADS overrides it
+        # where other work shares them (spinning llama.cpp threads that lose
+        # their core make decoding slower, not faster).
+        n_threads = int(os.environ.get("NRTRANS_THREADS", "0")) or min(4, os.cpu_count() or 1)
+    use_plain_cpu_buffers()
+    return llama_cpp.Llama(model_path=str(path), n_ctx=n_ctx, n_batch=512, verbose=False,
+                           lora_path=None if lora_path is None else str(lora_path), n_threads=n_threads)
 
 
 class _Trie:

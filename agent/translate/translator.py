@@ -46,6 +46,9 @@ _NOT_OBJECTS = frozenset({"left", "right", "start", "origin", "beginning", "way"
                           "point", "position", "spot", "area", "room", "around", "head", "camera"})
 
 
+_RANGE_CODES = frozenset({Code.OUT_OF_RANGE, Code.NOT_POSITIVE, Code.OUTSIDE_WORKSPACE})
+
+
 class Engine(Protocol):
     chat_template: str
 
@@ -70,6 +73,7 @@ class _ClauseState:
     program: str = ""
     extra: str = ""  # repair feedback appended to this clause's prompt
     objects: tuple[str, ...] | None = None
+    free_numbers: bool = False  # set after a range error, so the repair may pick any number
     lines: tuple[int, int] = (0, 0)
     timings: dict[str, float] = field(default_factory=dict)
 
@@ -147,7 +151,8 @@ class Translator:
         result = None
         for _ in range(self.options.max_passes):
             for state in pending:
-                generation = self.engine.generate(self._prompt(state), self._automaton(state), MAX_TOKENS)
+                prompt = self.prompt_for(state.clause.text, state.extra)
+                generation = self.engine.generate(prompt, self._automaton(state), MAX_TOKENS)
                 timings["prompt"] += generation.prompt_ms
                 timings["generate"] += generation.generate_ms
                 state.program = _tidy(generation.text)
@@ -170,12 +175,12 @@ class Translator:
                                  plan=result.plan if verified else None, model=self.model_name,
                                  timings_ms=timings)
 
-    def _prompt(self, state: _ClauseState) -> str:
-        text = state.clause.text
+    def prompt_for(self, text: str, extra: str = "") -> str:
+        """The prompt for one normalized clause; `extra` is repair feedback."""
         if self.options.adapter_prompt:
             from agent.adapter.prompt import adapter_prompt
 
-            return adapter_prompt(text) + state.extra
+            return adapter_prompt(text) + extra
         shots = pick_shots(self._bank, text, self.options.shots)
         if self.engine.chat_template:
             llm = getattr(self.engine, "llm", None)
@@ -183,14 +188,14 @@ class Translator:
             if llm is not None:
                 bos = llm.detokenize([llm.token_bos()]).decode("utf-8", "replace")
                 eos = llm.detokenize([llm.token_eos()]).decode("utf-8", "replace")
-            return chat_prompt(self.engine.chat_template, bos, eos, self._system, shots, text) + state.extra
-        return completion_prompt(self._system, shots, text) + state.extra
+            return chat_prompt(self.engine.chat_template, bos, eos, self._system, shots, text) + extra
+        return completion_prompt(self._system, shots, text) + extra
 
     def _automaton(self, state: _ClauseState) -> RslAutomaton | None:
         if not self.options.grammar:
             return None
         numbers = None
-        if self.options.narrow:
+        if self.options.narrow and not state.free_numbers:
             numbers = self._default_numbers | _task_numbers(state.clause.text)
         key = (state.objects, None if numbers is None else frozenset(numbers))
         automaton = self._automata.get(key)
@@ -227,6 +232,8 @@ class Translator:
                 continue
             if any(d.code is Code.UNKNOWN_OBJECT for d in mine) and known:
                 state.objects = tuple(sorted(known))
+            if any(d.code in _RANGE_CODES for d in mine):
+                state.free_numbers = True
             state.extra = feedback(state.program, mine)
             failing.append(state)
         if failing:

@@ -1,0 +1,106 @@
+"""The translation loop with the real embedded model: contract, grammar, repair, cap, fallback."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+
+from agent.translate import ModelNotFoundError, Translator
+from agent.translate.automaton import END, START, RslAutomaton
+from agent.translate.engine import TokenMasks
+from rsl.compiler import compile_program
+from rsl.diagnostics import Code
+from rsl.profile import Profile
+
+CONTRACT_KEYS = {"task", "program", "verified", "passes", "attempts", "plan", "model", "timings_ms"}
+
+
+def _variant(translator: Translator, **changes: object) -> Translator:
+    """The same loaded model with other options, so no test loads it twice."""
+    options = dataclasses.replace(translator.options, **changes)  # type: ignore[arg-type]
+    return Translator(translator.profile, translator.engine, translator.model_name, options)
+
+
+def test_result_follows_the_json_contract(translator: Translator, profile: Profile) -> None:
+    result = translator.translate("move forward two meters, then grasp the cup", known_objects=["cup"])
+    data = result.to_json_dict()
+    assert set(data) == CONTRACT_KEYS
+    assert set(data["timings_ms"]) == {"prompt", "generate", "compile", "total"}
+    assert data["passes"] == len(data["attempts"]) >= 1
+    assert all(set(a) == {"program", "diagnostics"} for a in data["attempts"])
+    assert data["program"] == data["attempts"][-1]["program"]
+    if result.verified:
+        assert result.plan is not None and compile_program(result.program, profile, ["cup"]).ok
+        assert [c["rsl"] for c in data["plan"]] == result.program.splitlines()
+    else:
+        assert data["plan"] == []
+
+
+@pytest.mark.parametrize("task", ["turn left ninety degrees", "uh go to 1, -2 then look around",
+                                  "approach the red box and take it", "spin in a full circle"])
+def test_grammar_makes_syntax_errors_impossible(translator: Translator, task: str) -> None:
+    result = translator.translate(task)
+    for attempt in result.attempts:
+        assert all(d.code.is_semantic for d in attempt.diagnostics), attempt
+    assert result.verified, result.attempts
+
+
+def test_loop_repairs_an_unknown_object(translator: Translator) -> None:
+    """The task names a mug, the robot only knows a cup: the compiler's E104 drives a second pass."""
+    seen = []
+    result = translator.translate("grasp the mug", known_objects=["cup"], on_attempt=seen.append)
+    assert len(seen) == result.passes == 2
+    assert [d.code for d in result.attempts[0].diagnostics] == [Code.UNKNOWN_OBJECT]
+    assert result.verified and result.plan is not None
+    assert {c.object() for c in result.plan if c.skill in ("grasp", "approach")} == {"cup"}
+
+
+def test_pass_cap_is_honoured(translator: Translator) -> None:
+    capped = _variant(translator, max_passes=1)
+    result = capped.translate("grasp the mug", known_objects=["cup"])
+    assert result.passes == 1 and len(result.attempts) == 1
+    assert not result.verified and result.plan is None
+
+
+def test_no_grammar_mode_still_compiles_every_candidate(translator: Translator) -> None:
+    free = _variant(translator, grammar=False)
+    result = free.translate("turn left 90 degrees")
+    assert 1 <= result.passes <= 3
+    for attempt in result.attempts:
+        assert attempt.program or attempt.diagnostics
+    assert result.verified == (not result.attempts[-1].diagnostics)
+
+
+def test_token_masks_only_allow_tokens_that_stay_in_the_language(translator: Translator,
+                                                                 profile: Profile) -> None:
+    automaton = RslAutomaton(profile, objects=["cup"])
+    masks = TokenMasks(automaton, translator.engine.vocabulary)  # type: ignore[attr-defined]
+    pieces = translator.engine.vocabulary.pieces  # type: ignore[attr-defined]
+    for prefix in ["", "forward ", "forward 1", "grasp ", "goto -", "perceive;", "perceive;\n"]:
+        state = automaton.walk(START, prefix)
+        ids, states = masks.at(state)
+        assert len(ids) > 0
+        for token, after in zip(ids.tolist()[:400], states[:400], strict=True):
+            assert automaton.walk(state, pieces[token].decode("ascii")) == after
+    assert END in masks.at(automaton.walk(START, "perceive;\n"))[1]
+
+
+def test_prompt_prefix_is_reused_across_requests(translator: Translator) -> None:
+    engine = translator.engine
+    first = engine.generate(translator.prompt_for("turn left 1 rad"), None, 4)
+    second = engine.generate(translator.prompt_for("go back 2 m"), None, 4)
+    assert first.prompt_tokens > 200
+    assert second.reused_tokens >= len(translator._system) // 8  # the whole system text, at least
+
+
+def test_empty_task_is_not_verified(translator: Translator) -> None:
+    result = translator.translate("uh um")
+    assert not result.verified and result.passes == 0 and result.program == ""
+
+
+def test_missing_model_gives_a_clear_error(profile: Profile, tmp_path) -> None:
+    with pytest.raises(ModelNotFoundError, match="does not exist"):
+        Translator.load(profile, model=str(tmp_path / "missing.gguf"))
+    with pytest.raises(ModelNotFoundError, match="adapter"):
+        Translator.load(profile, adapter=str(tmp_path / "missing-adapter.gguf"))
