@@ -142,7 +142,7 @@ def _parse_number(tokens: Sequence[str], i: int) -> tuple[float, int] | None:
         value, j = float(tokens[j]), j + 1
     elif (parsed := _parse_integer_words(tokens, j)) is not None:
         value, j = parsed
-    elif j < len(tokens) and tokens[j] == "point":
+    elif j + 1 < len(tokens) and tokens[j] == "point" and tokens[j + 1] in _DIGIT_WORDS:
         value = 0.0
     else:
         return None
@@ -214,7 +214,7 @@ def _convert_numbers(tokens: list[str]) -> list[str]:
     while i < len(tokens):
         token = tokens[i]
         converted = _convert_at(tokens, i)
-        if converted is not None:
+        if converted is not None and converted[1] > i:
             text, i = converted
             out.append(text)
             continue

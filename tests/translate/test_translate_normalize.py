@@ -1,6 +1,8 @@
 """The normalizer's output format is a contract with the adapter's training data."""
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from agent.normalize import normalize_task
 
@@ -29,6 +31,8 @@ from agent.normalize import normalize_task
         ("do it twice", "do it 2 times"),
         ("Turn LEFT 3.14159 radians!", "turn left 3.1416 rad"),
         ("move forward 300 millimetres", "move forward 0.3 m"),
+        ("drive to the point -2, 1.5", "drive to the point -2, 1.5"),
+        ("drive point five meters", "drive 0.5 m"),
     ],
 )
 def test_normalize_converts_numbers_units_and_fillers(task: str, expected: str) -> None:
@@ -46,6 +50,14 @@ def test_normalize_keeps_words_that_only_sound_like_numbers(task: str) -> None:
 def test_normalize_is_idempotent_on_its_own_output() -> None:
     for task in ["move forward 2 m, then grasp the cup", "turn left 1.5708 rad", "go to -3.5, 2"]:
         assert normalize_task(normalize_task(task)) == normalize_task(task)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.sampled_from(["point", "minus", "half", "a", "and", "to", "for", "two", "five", "m",
+                                 "degrees", "turns", "full", "1.5", "-", ",", "the", "twenty", "hundred",
+                                 "quarter", "of", "times", "."]), max_size=12))
+def test_normalize_terminates_on_any_word_salad(words: list[str]) -> None:
+    assert isinstance(normalize_task(" ".join(words)), str)
 
 
 def test_normalize_of_empty_or_filler_only_text_is_empty() -> None:
