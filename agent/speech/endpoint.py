@@ -1,7 +1,7 @@
-"""End of speech by silence, from the loudness of each audio block.
+"""Telling speech from quiet by loudness: end of speech by silence, and when to listen at all.
 
 Vosk has its own endpointing, but its trailing-silence rules come from the
-model's config and cannot be set per robot; this detector makes
+model's config and cannot be set per robot; `SilenceDetector` makes
 `silence_ms` mean what it says on any model and any microphone.
 """
 
@@ -15,29 +15,38 @@ MIN_SPEECH_RMS = 300.0
 FLOOR_FACTOR = 3.0
 
 
+class NoiseFloor:
+    """The room's loudness, followed slowly, so a fan or a hum raises the bar for speech."""
+
+    def __init__(self) -> None:
+        self.floor: float | None = None
+
+    def is_loud(self, block: bytes) -> bool:
+        level = rms(block)
+        loud = level > max(MIN_SPEECH_RMS, (self.floor or 0.0) * FLOOR_FACTOR)
+        if not loud:
+            self.floor = level if self.floor is None else 0.95 * self.floor + 0.05 * level
+        return loud
+
+
 class SilenceDetector:
     def __init__(self, rate: int, silence_ms: int) -> None:
         self.rate = rate
         self.silence_samples = rate * silence_ms // 1000
-        self.floor: float | None = None
+        self.noise = NoiseFloor()
         self.heard_speech = False
         self.quiet_samples = 0
         self.samples = 0
 
     def feed(self, block: bytes) -> bool:
         """Add a block of int16 samples; True once speech was heard and then `silence_ms` of quiet."""
-        level = rms(block)
         count = len(block) // 2
         self.samples += count
-        threshold = max(MIN_SPEECH_RMS, (self.floor or 0.0) * FLOOR_FACTOR)
-        if level > threshold:
+        if self.noise.is_loud(block):
             self.heard_speech = True
             self.quiet_samples = 0
         else:
             self.quiet_samples += count
-            # The floor follows the room slowly, so a fan or a hum raises the
-            # bar for speech without a single loud block doing so.
-            self.floor = level if self.floor is None else 0.95 * self.floor + 0.05 * level
         return self.heard_speech and self.quiet_samples >= self.silence_samples
 
     @property

@@ -13,15 +13,15 @@ import logging
 import queue
 import threading
 import time
-from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 from agent.speech.endpoint import SilenceDetector
 from agent.speech.lexicon import lexicon_for
-from agent.speech.recognizer import LoadedModel, load_model, result_text
+from agent.speech.recognizer import LoadedModel, load_model
 from agent.speech.records import SpeechConfig, SpeechEvent, Transcript, TranscriptSource
+from agent.speech.spotting import TimedRecognizer, WakeSpotter, trim_leading_quiet, words_after
 from agent.speech.vocabulary import UNKNOWN, Vocabulary
 
 log = logging.getLogger("nrtrans.speech")
@@ -43,6 +43,9 @@ class _Utterance:
     source: TranscriptSource
     started_at: float
     detector: SilenceDetector
+    # The task recogniser's time where the wake word ended; words before it
+    # are not part of the task.
+    cut_s: float | None
     # After a lone wake word the task comes in a second utterance.
     follow_up: bool = False
 
@@ -152,6 +155,7 @@ class SpeechInput:
                     log.warning("speech input has no audio device: %s; retrying every %.0f s",
                                 message, self.config.retry_s)
                 self._stopping.wait(self.config.retry_s)
+                _rescan_devices()
                 continue
             reported = ""
             try:
@@ -247,11 +251,11 @@ class SpeechInput:
         model = self._model
         vocabulary = self._vocabulary(model)
         bias = self.config.grammar_bias and model.runtime_grammar
-        utterance_recognizer = model.recognizer(rate, vocabulary.grammar() if bias else None)
-        wake_recognizer = model.recognizer(rate, self._wake_grammar(vocabulary)) if self._wake_words else None
-        preroll: deque[bytes] = deque(maxlen=int(PREROLL_S * 10) + 1)
+        task = TimedRecognizer(model.recognizer(rate, vocabulary.grammar() if bias else None), rate)
+        spotter = WakeSpotter(TimedRecognizer(model.recognizer(rate, self._wake_grammar(vocabulary)), rate),
+                              self._wake_words, PREROLL_S) if self._wake_words else None
         utterance: _Utterance | None = None
-        idle_state = "waiting_for_wake_word" if wake_recognizer is not None else "push_to_talk_only"
+        idle_state = "waiting_for_wake_word" if spotter is not None else "push_to_talk_only"
         self._set_state(idle_state)
         self._emit("ready", device=self._device_info["name"], sample_rate=rate,
                    vocabulary_size=len(vocabulary) if bias else 0)
@@ -267,26 +271,17 @@ class SpeechInput:
             if utterance is None and self._objects_changed.is_set():
                 self._objects_changed.clear()
                 vocabulary = self._vocabulary(model)
-                utterance_recognizer = model.recognizer(rate, vocabulary.grammar() if bias else None)
+                task = TimedRecognizer(model.recognizer(rate, vocabulary.grammar() if bias else None), rate)
             if utterance is None and self._push_to_talk.is_set():
                 self._push_to_talk.clear()
-                utterance = self._begin(utterance_recognizer, rate, "push_to_talk", [])
+                utterance = self._begin(task, "push_to_talk", ())
             if utterance is None:
-                preroll.append(block)
-                if wake_recognizer is None:
-                    continue
-                heard, segment_over = self._heard_wake_word(wake_recognizer, block)
-                if heard:
-                    wake_recognizer.Reset()
+                hit = spotter.feed(block) if spotter is not None else None
+                if hit is not None:
                     self._emit("wake")
-                    utterance = self._begin(utterance_recognizer, rate, "wake_word", list(preroll))
-                    preroll.clear()
-                elif segment_over:
-                    # Keep the pre-roll to the current stretch of speech, so
-                    # an earlier sentence is not glued to the task.
-                    preroll.clear()
+                    utterance = self._begin(task, "wake_word", hit.audio, hit.wake_end_s)
                 continue
-            utterance = self._continue(utterance, utterance_recognizer, block, rate)
+            utterance = self._continue(utterance, task, block)
             if utterance is None:
                 self._set_state(idle_state)
 
@@ -299,33 +294,28 @@ class SpeechInput:
                                                              if w not in self._wake_words]
         return json.dumps([*self._wake_words, *others], ensure_ascii=False)
 
-    def _heard_wake_word(self, recognizer: Any, block: bytes) -> tuple[bool, bool]:
-        """(wake word heard, Vosk closed the segment)."""
-        segment_over = bool(recognizer.AcceptWaveform(block))
-        text = result_text(recognizer.Result() if segment_over else recognizer.PartialResult())
-        padded = f" {text} "
-        return any(f" {wake} " in padded for wake in self._wake_words), segment_over
-
-    def _begin(self, recognizer: Any, rate: int, source: TranscriptSource, preroll: list[bytes],
-               follow_up: bool = False) -> _Utterance:
-        recognizer.Reset()
-        detector = SilenceDetector(rate, self.config.silence_ms)
-        seconds = sum(len(b) for b in preroll) / 2 / rate
-        utterance = _Utterance(source, time.time() - seconds, detector, follow_up)
-        for block in preroll:
-            recognizer.AcceptWaveform(block)
+    def _begin(self, task: TimedRecognizer, source: TranscriptSource, audio: tuple[bytes, ...],
+               wake_end_s: float | None = None, follow_up: bool = False) -> _Utterance:
+        task.reset()
+        detector = SilenceDetector(task.rate, self.config.silence_ms)
+        audio, dropped = trim_leading_quiet(audio, task.rate)
+        seconds = sum(len(b) for b in audio) / 2 / task.rate
+        cut = None if wake_end_s is None else task.now + wake_end_s - dropped
+        utterance = _Utterance(source, time.time() - seconds, detector, cut, follow_up)
+        for block in audio:
+            task.accept(block)
             detector.feed(block)
         self._set_state("listening")
         self._emit("listening", source=source)
         return utterance
 
-    def _continue(self, utterance: _Utterance, recognizer: Any, block: bytes, rate: int) -> _Utterance | None:
+    def _continue(self, utterance: _Utterance, task: TimedRecognizer, block: bytes) -> _Utterance | None:
         """Feed one block; returns the utterance still in progress, or None when it is over."""
-        endpoint = recognizer.AcceptWaveform(block)
+        endpoint = task.accept(block)
         silent = utterance.detector.feed(block)
         detector = utterance.detector
         if not detector.heard_speech and detector.seconds >= self.config.no_speech_timeout_s:
-            recognizer.Reset()
+            task.reset()
             self._emit("no_speech", source=utterance.source)
             return None
         if endpoint and not detector.heard_speech:
@@ -334,13 +324,12 @@ class SpeechInput:
             return utterance
         if not (endpoint or silent or detector.seconds >= self.config.max_utterance_s):
             return utterance
-        text = result_text(recognizer.Result() if endpoint else recognizer.FinalResult())
-        recognizer.Reset()
-        text = self._strip_wake_word(text)
+        text = words_after(task.result(endpoint), utterance.cut_s, self._wake_words)
+        task.reset()
         if not text:
             if utterance.source == "wake_word" and not utterance.follow_up:
                 # "Robot." ... "go forward": the task comes next.
-                return self._begin(recognizer, rate, "wake_word", [], follow_up=True)
+                return self._begin(task, "wake_word", (), follow_up=True)
             self._emit("empty", source=utterance.source)
             return None
         transcript = Transcript(text, utterance.started_at, time.time(), utterance.source)
@@ -352,12 +341,6 @@ class SpeechInput:
         except Exception:
             log.exception("the transcript handler failed for %r", text)
         return None
-
-    def _strip_wake_word(self, text: str) -> str:
-        """The words after the first wake word; all of them when there is none."""
-        padded = f" {text} "
-        cut = [padded.find(f" {wake} ") + len(wake) + 1 for wake in self._wake_words if f" {wake} " in padded]
-        return padded[min(cut):].strip() if cut else text.strip()
 
     # -- reporting ------------------------------------------------------------------------
 
@@ -376,6 +359,17 @@ class SpeechInput:
 
 class _DeviceLost(RuntimeError):
     pass
+
+
+def _rescan_devices() -> None:
+    """Restart PortAudio so a microphone plugged in (or a sound server started) since is seen."""
+    try:
+        import sounddevice as sd
+
+        sd._terminate()
+        sd._initialize()
+    except Exception as exc:
+        log.debug("rescanning audio devices: %s", exc)
 
 
 def _close(stream: Any) -> None:

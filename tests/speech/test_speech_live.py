@@ -1,0 +1,70 @@
+"""Live capture: espeak-ng Korean played into a PulseAudio null sink, heard through sounddevice and Vosk."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+
+from agent.speech import SpeechConfig, SpeechInput, SpeechUnavailable
+from tests.speech.helpers import KOREAN, next_transcript, running, wait_for
+
+
+def test_wake_word_then_task_is_transcribed(mic, say, collector) -> None:
+    config = SpeechConfig(**KOREAN)
+    with running(config, collector) as speech:
+        wait_for(lambda: speech.health()["state"] == "waiting_for_wake_word", 30, "the wake-word state")
+        health = speech.health()
+        assert health["ok"] and health["listening"] and health["audio_device"]["present"]
+        assert health["model"]["runtime_grammar"] and health["grammar_bias"]
+        assert health["vocabulary_size"] > 40
+
+        said_at = time.time()
+        mic.play(say("로봇 원점 이동"))
+        transcript = next_transcript(collector)
+        assert transcript.text == "원점 이동", "the wake word is stripped and the task kept"
+        assert transcript.source == "wake_word"
+        assert said_at - 1 <= transcript.started_at <= transcript.ended_at <= time.time()
+        kinds = collector.kinds()
+        assert kinds.index("ready") < kinds.index("wake") < kinds.index("listening") < kinds.index("heard")
+        wait_for(lambda: speech.health()["state"] == "waiting_for_wake_word", 5, "the return to waiting")
+
+        # Without the wake word nothing is taken as a task.
+        mic.play(say("오른쪽 봐"))
+        time.sleep(2.0)
+        assert collector.transcripts.empty()
+        assert speech.health()["transcripts"] == 1
+
+
+def test_push_to_talk_takes_one_utterance(mic, say, collector) -> None:
+    config = SpeechConfig(**{**KOREAN, "wake_words": ()})
+    with running(config, collector) as speech:
+        wait_for(lambda: speech.health()["state"] == "push_to_talk_only", 30, "push-to-talk readiness")
+        mic.play(say("원점 이동"))
+        time.sleep(1.0)
+        assert collector.transcripts.empty(), "speech before push-to-talk must be ignored"
+
+        speech.listen_now()
+        mic.play(say("로봇 오른쪽 봐"))
+        transcript = next_transcript(collector)
+        assert transcript.text == "오른쪽 봐"
+        assert transcript.source == "push_to_talk"
+
+
+def test_push_to_talk_without_speech_times_out(mic, collector) -> None:
+    config = SpeechConfig(**{**KOREAN, "wake_words": (), "no_speech_timeout_s": 1.0})
+    with running(config, collector) as speech:
+        wait_for(lambda: speech.health()["state"] == "push_to_talk_only", 30, "push-to-talk readiness")
+        speech.listen_now()
+        wait_for(lambda: "no_speech" in collector.kinds(), 5, "the no_speech event")
+        assert collector.transcripts.empty()
+        assert speech.health()["state"] == "push_to_talk_only"
+
+
+def test_disabled_input_does_nothing(collector) -> None:
+    speech = SpeechInput(SpeechConfig(enabled=False), collector.on_transcript, collector.on_event)
+    speech.start()
+    assert speech.health()["state"] == "disabled" and not speech.health()["ok"]
+    with pytest.raises(SpeechUnavailable):
+        speech.listen_now()
+    speech.stop()
