@@ -50,6 +50,7 @@ class Service:
         self._worker: threading.Thread | None = None
         self._worker_error: str | None = None
         self.warm_s: float | None = None
+        self._execute_plan: Callable[..., Any] | None = None
 
     # -- start and stop -------------------------------------------------------------------------
 
@@ -70,6 +71,7 @@ class Service:
         self.translator = _load_translator(self.config, self.profile)
         self.on_status(f"opening the {self.config.robot.backend} backend")
         self.robot = _open_robot(self.config, self.profile)
+        self._execute_plan = _load_executor()
         if self.config.speech.enabled:
             self.on_status("starting speech input")
             self._start_speech()
@@ -390,8 +392,6 @@ class Service:
         return result.plan
 
     def _execute(self, task: Task, plan: Any, start: float) -> None:
-        from agent.executor import execute
-
         def on_step(step: Any) -> None:
             number = step.index + 1
             if step.outcome is None:
@@ -416,7 +416,8 @@ class Service:
                 "step", task.id, step=number, total=step.total, statement=step.statement, outcome=outcome
             )
 
-        result = execute(plan, self.robot, self.profile, cancel=task.cancel, on_event=on_step)
+        assert self._execute_plan is not None, "load() sets the executor"
+        result = self._execute_plan(plan, self.robot, self.profile, cancel=task.cancel, on_event=on_step)
         task.mark("total_ms", start)
         status = getattr(result.status, "value", result.status)
         final_state = result.final_state.to_dict() if result.final_state is not None else None
@@ -560,6 +561,16 @@ def _load_translator(config: Config, profile: Any) -> Any:
             "  = help: check translator.model and translator.adapter in the config; "
             "`nrtrans models list` shows the models installed here"
         ) from exc
+
+
+def _load_executor() -> Callable[..., Any]:
+    try:
+        from agent.executor import execute
+    except ImportError as exc:
+        raise StartupError(
+            f"cannot load the plan executor: {exc}\n  = help: reinstall nrtrans; agent/executor.py is part of it"
+        ) from exc
+    return execute
 
 
 def _open_robot(config: Config, profile: Any) -> Any:
