@@ -78,3 +78,23 @@ def test_each_straight_move_and_turn_is_within_2cm_and_1_degree(robot: Ros2Robot
     assert robot.turnleft(6.2832 + 0.5).ok  # more than a full circle must count the full circle
     again = robot.state().pose
     assert abs(math.remainder(again.heading - (turned.heading + 0.5), 2 * math.pi)) < math.radians(1.0)
+
+
+def test_the_head_stops_at_its_joint_limits(robot: Ros2Robot, profile: Profile) -> None:
+    outcome = robot.lookleft(3.0)
+    assert outcome.ok and "pan limited to 1.57 rad" in outcome.reason
+    assert robot.state().head_pan == pytest.approx(profile.head["pan"][1], abs=0.01)
+    outcome = robot.lookdown(1.2)
+    assert outcome.ok and "tilt limited to -0.6 rad" in outcome.reason
+    assert robot.state().head_tilt == pytest.approx(profile.head["tilt"][0], abs=0.01)
+
+
+def test_grasp_refuses_when_another_object_is_nearer_the_gripper(robot: Ros2Robot) -> None:
+    assert robot.perceive().ok
+    assert robot.approach("bottle").ok
+    outcome = robot.grasp("cup")
+    assert not outcome.ok
+    assert "bottle is nearer to the gripper than cup" in outcome.reason
+    assert robot.state().holding is None
+    assert robot.grasp("bottle").ok
+    assert robot.state().holding == "bottle"
