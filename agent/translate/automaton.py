@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 import string
-from collections.abc import Collection, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from typing import Any
 
 from rsl.grammar import MAX_FRACTION_DIGITS
@@ -31,14 +31,15 @@ class RslAutomaton:
     """`step(state, char)` walks one character; `None` means the text left the language."""
 
     def __init__(self, profile: Profile, *, keywords: Collection[str] | None = None,
-                 objects: Sequence[str] | None = None, numbers: Collection[str] | None = None,
+                 objects: Sequence[str] | None = None, numbers: Mapping[str, Collection[str]] | None = None,
                  max_statements: int | None = None) -> None:
         if objects is not None:
             bad = [o for o in objects if not IDENTIFIER.match(o)]
             if bad:
                 raise ValueError(f"object names must be C identifiers: {', '.join(map(repr, bad))}")
         self.objects = None if objects is None else tuple(sorted(set(objects)))
-        self.numbers = None if numbers is None else frozenset(numbers)
+        # Number spellings allowed per unit ("m", "rad"); a unit with none left is free.
+        self.numbers = None if numbers is None else {u: frozenset(v) for u, v in numbers.items() if v}
         allowed = set(profile.keywords if keywords is None else keywords)
         self.skills: dict[str, Skill] = {
             s.keyword: s for s in profile.skills
@@ -51,7 +52,9 @@ class RslAutomaton:
         # model repeating its last line stops; the compiler's cap stays the law.
         self.max_statements = max_statements or profile.max_statements
         self.key = (tuple(sorted(self.skills)), self.objects,
-                    None if self.numbers is None else tuple(sorted(self.numbers)), self.max_statements)
+                    None if self.numbers is None else tuple(sorted((u, tuple(sorted(v)))
+                                                                   for u, v in self.numbers.items())),
+                    self.max_statements)
         self._number_shape = {(s.keyword, i): _number_shape(p) for s in self.skills.values()
                               for i, p in enumerate(s.params) if p.kind == "number"}
         self._memo: dict[tuple[State, str], State | None] = {}
@@ -105,9 +108,16 @@ class RslAutomaton:
         param = self.skills[keyword].params[index]
         if param.kind == "object":
             return ("P", keyword, index, "o", "")
-        if self.numbers is not None:
+        if self._literals(keyword, index):
             return ("P", keyword, index, "l", "")
         return ("P", keyword, index, "n", "start")
+
+    def _literals(self, keyword: str, index: int) -> frozenset[str]:
+        if self.numbers is None:
+            return frozenset()
+        signed = self._number_shape[(keyword, index)][1]
+        allowed = self.numbers.get(self.skills[keyword].params[index].unit, frozenset())
+        return frozenset(n for n in allowed if signed or not n.startswith("-"))
 
     def _param_done(self, keyword: str, index: int, char: str) -> State | None:
         count = len(self.skills[keyword].params)
@@ -125,9 +135,7 @@ class RslAutomaton:
             return self._in_object(keyword, index, value, char)
         if sub == "l":
             longer = value + char
-            numbers = self.numbers or frozenset()
-            signed = self._number_shape[(keyword, index)][1]
-            ok = any(n.startswith(longer) and (signed or not n.startswith("-")) for n in numbers)
+            ok = any(n.startswith(longer) for n in self._literals(keyword, index))
             return ("P", keyword, index, "l", longer) if ok else None
         phase = _number_phase(value, char, *self._number_shape[(keyword, index)])
         return None if phase is None else ("P", keyword, index, "n", phase)
@@ -149,7 +157,7 @@ class RslAutomaton:
         if sub == "o":
             return value in self.objects if self.objects is not None else bool(value)
         if sub == "l":
-            return value in (self.numbers or ())
+            return value in self._literals(keyword, index)
         return value == "zero" or (isinstance(value, tuple) and value[1] >= 1)
 
     def to_gbnf(self) -> str:
@@ -172,10 +180,10 @@ class RslAutomaton:
                 rules["object"] = " | ".join(f'"{o}"' for o in self.objects)
             return "object"
         digits, signed = self._number_shape[(keyword, index)]
-        if self.numbers is not None:
-            name = "coordinate-literal" if signed else "number-literal"
-            allowed = sorted(n for n in self.numbers if signed or not n.startswith("-"))
-            rules[name] = " | ".join(f'"{n}"' for n in allowed) or '"0"'
+        literals = self._literals(keyword, index)
+        if literals:
+            name = f"{'coordinate' if signed else 'number'}-{param.unit or 'plain'}-literal"
+            rules[name] = " | ".join(f'"{n}"' for n in sorted(literals))
             return name
         name = f"{'coordinate' if signed else 'number'}-{digits}"
         integer = '("0" | [1-9]' + (f" [0-9]{{0,{digits - 1}}}" if digits > 1 else "") + ")"

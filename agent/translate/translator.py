@@ -8,6 +8,7 @@ compiles without a diagnostic comes back with a plan.
 
 from __future__ import annotations
 
+import itertools
 import re
 import threading
 import time
@@ -32,14 +33,18 @@ from agent.translate.prompt import (
 from agent.translate.result import Attempt, TranslationResult
 from rsl.compiler import compile_program
 from rsl.diagnostics import Code, Diagnostic
-from rsl.profile import Profile
+from rsl.plan import Quantity, format_number
+from rsl.profile import Convention, Profile
 
 MAX_TOKENS = 160
 # One clause rarely needs more; a square is 8 statements.
 CLAUSE_STATEMENTS = 8
 DEFAULT_SHOTS = 4
 _NUMBER = re.compile(r"-?\d*\.?\d+")
+_NUMBER_UNIT = re.compile(r"(-?\d*\.?\d+)(?: (m|rad)\b)?")
 _OBJECT_PHRASE = re.compile(r"\b(?:the|a|an|some|that|this|my|your) ((?:[a-z]+ )?[a-z]+)\b")
+_PHRASE_END = frozenset({"with", "and", "for", "to", "from", "on", "in", "of", "at", "by", "then", "it", "up",
+                         "down", "again", "into", "onto", "over", "under", "near", "there", "here", "times"})
 _NOT_OBJECTS = frozenset({"left", "right", "start", "origin", "beginning", "way", "same", "other", "front",
                           "back", "end", "middle", "centre", "center", "robot", "side", "distance", "time",
                           "little", "bit", "square", "triangle", "circle", "full", "long", "few", "couple",
@@ -73,6 +78,8 @@ class _ClauseState:
     program: str = ""
     extra: str = ""  # repair feedback appended to this clause's prompt
     objects: tuple[str, ...] | None = None
+    keywords: tuple[str, ...] | None = None
+    max_statements: int | None = None
     free_numbers: bool = False  # set after a range error, so the repair may pick any number
     lines: tuple[int, int] = (0, 0)
     timings: dict[str, float] = field(default_factory=dict)
@@ -89,7 +96,8 @@ class Translator:
         self._lock = threading.Lock()
         self._system = system_text(profile)
         self._bank: tuple[Shot, ...] = load_shots(profile)
-        self._default_numbers = _convention_numbers(profile)
+        self._units = sorted({p.unit for s in profile.skills for p in s.params if p.kind == "number"})
+        self._conventions = [(c, _convention_numbers(c, profile)) for c in profile.conventions]
         self._automata: dict[Any, RslAutomaton] = {}
 
     @classmethod
@@ -146,6 +154,8 @@ class Translator:
         states = [_ClauseState(c) for c in clauses]
         for state in states:
             state.objects = self._task_objects(state.clause.text)
+            if self.options.narrow:
+                state.keywords, state.max_statements = self._clause_skills(state.clause.text)
         attempts: list[Attempt] = []
         pending = [s for s in states if not s.clause.repeat_previous]
         result = None
@@ -196,16 +206,83 @@ class Translator:
             return None
         numbers = None
         if self.options.narrow and not state.free_numbers:
-            numbers = self._default_numbers | _task_numbers(state.clause.text)
-        key = (state.objects, None if numbers is None else frozenset(numbers))
+            # A clause that states its numbers means them; the conventions'
+            # numbers are only for vague clauses. Polygon turns stay for both.
+            said = _task_numbers(state.clause.text, self._units)
+            numbers = said if said else self._vague_numbers(state.clause.text)
+        cap = state.max_statements or (CLAUSE_STATEMENTS if self.options.split_clauses else None)
+        number_key = None if numbers is None else tuple(sorted((u, frozenset(v)) for u, v in numbers.items()))
+        key = (state.objects, number_key, state.keywords, cap)
         automaton = self._automata.get(key)
         if automaton is None:
             if len(self._automata) > 256:
                 self._automata.clear()
-            cap = CLAUSE_STATEMENTS if self.options.split_clauses else None
-            automaton = self._automata[key] = RslAutomaton(self.profile, objects=state.objects, numbers=numbers,
-                                                           max_statements=cap)
+            try:
+                automaton = RslAutomaton(self.profile, keywords=state.keywords, objects=state.objects,
+                                         numbers=numbers, max_statements=cap)
+            except ValueError:
+                # The narrowing left nothing (say, only object skills and no object): drop it.
+                automaton = RslAutomaton(self.profile, objects=state.objects, numbers=numbers)
+            self._automata[key] = automaton
         return automaton
+
+    def _vague_numbers(self, text: str) -> dict[str, set[str]]:
+        """For a clause with no number: the numbers of the conventions it uses.
+
+        A clause that uses no convention phrase gets the defaults: the
+        conventions whose phrase is not in their own example task ("no
+        amount given", "back to the start").
+        """
+        matched = [numbers for c, numbers in self._conventions if c.phrase in text]
+        if not matched:
+            matched = [numbers for c, numbers in self._conventions if c.phrase not in c.task]
+        merged: dict[str, set[str]] = {}
+        for numbers in matched:
+            for unit, values in numbers.items():
+                merged.setdefault(unit, set()).update(values)
+        return merged
+
+    def _clause_skills(self, text: str) -> tuple[tuple[str, ...] | None, int | None]:
+        """The skills a single-action clause names, and how many statements it may take.
+
+        A skill scores when a clause word or word pair is its keyword or an
+        alias ("back up" is `backup`), when a word starts or ends its keyword
+        ("look" and "up" in `lookup`), and when the clause has the arguments
+        it needs (a named object, a pair of numbers). The best-scoring skills
+        stay. A convention phrase ("look around") adds its program's skills
+        and allows its length. Nothing scoring means no narrowing.
+        """
+        if not self.options.split_clauses:
+            return None, None
+        words = re.findall(r"[a-z]+", text)
+        pairs = {a + b for a, b in itertools.pairwise(words)} | {f"{a}_{b}" for a, b in itertools.pairwise(words)}
+        numbers = len(_NUMBER.findall(text))
+        has_object = bool(self._task_objects(text))
+        scores: dict[str, int] = {}
+        for skill in self.profile.skills:
+            names = {skill.keyword, *skill.aliases}
+            score = 2 * sum(1 for w in set(words) if w in names) + 3 * min(1, len(pairs & names))
+            score += 1 if skill.keyword in words else 0
+            score += sum(1 for w in set(words) if len(w) >= 2 and w != skill.keyword
+                         and (skill.keyword.startswith(w) or skill.keyword.endswith(w)))
+            wanted_numbers = sum(1 for p in skill.params if p.kind == "number")
+            if any(p.kind == "object" for p in skill.params) and has_object:
+                score += 1
+            if wanted_numbers >= 2:
+                score += 3 if numbers >= wanted_numbers else -5
+            scores[skill.keyword] = score
+        best = max(scores.values(), default=0)
+        chosen = {k for k, v in scores.items() if best > 0 and v == best}
+        statements = 1
+        for convention in self.profile.conventions:
+            if convention.phrase in text and convention.program:
+                program = compile_program(convention.program, self.profile).plan
+                if program is not None:
+                    chosen.update(c.skill for c in program)
+                    statements = max(statements, len(program))
+        if not chosen:
+            return None, None
+        return tuple(sorted(chosen)), statements
 
     def _task_objects(self, text: str) -> tuple[str, ...] | None:
         """Object names the clause itself mentions (`the red cup` -> red_cup, cup)."""
@@ -213,7 +290,10 @@ class Translator:
             return None
         names: list[str] = []
         for phrase in _OBJECT_PHRASE.findall(text):
-            words = [w for w in phrase.split() if w not in _NOT_OBJECTS]
+            words = phrase.split()
+            if len(words) == 2 and words[1] in _PHRASE_END:
+                words = words[:1]
+            words = [w for w in words if w not in _NOT_OBJECTS and w not in _PHRASE_END]
             if not words:
                 continue
             names.append(words[-1])
@@ -262,24 +342,28 @@ def _assemble(states: list[_ClauseState]) -> str:
     return program
 
 
-def _task_numbers(text: str) -> set[str]:
-    numbers = set()
-    for match in _NUMBER.findall(text):
-        value = match.lstrip("-")
-        numbers.update({value, "-" + value})
+def _task_numbers(text: str, units: list[str]) -> dict[str, set[str]]:
+    """Numbers the clause says, by unit; a number without a unit may be any unit."""
+    numbers: dict[str, set[str]] = {}
+    for value, unit in _NUMBER_UNIT.findall(text):
+        magnitude = value.lstrip("-")
+        for target in [unit] if unit else units:
+            numbers.setdefault(target, set()).update({magnitude, "-" + magnitude})
     return numbers
 
 
-def _convention_numbers(profile: Profile) -> set[str]:
-    """Numbers a task may imply without saying them: the profile's conventions, polygon turns, zero."""
-    from rsl.plan import format_number
-
-    numbers = {"0"}
-    for convention in profile.conventions:
-        numbers.update(_NUMBER.findall(convention.program))
-        numbers.update(_NUMBER.findall(convention.meaning))
-    numbers.update(format_number(6.283185307179586 / sides) for sides in range(3, 9))
-    return {n.lstrip("-") for n in numbers if n.lstrip("-") not in ("", ".")}
+def _convention_numbers(convention: Convention, profile: Profile) -> dict[str, set[str]]:
+    """The numbers, by unit, of a convention's program and its meaning text ("0.2 m ..., 0.2618 rad")."""
+    numbers: dict[str, set[str]] = {}
+    plan = compile_program(convention.program, profile).plan if convention.program else None
+    for command in plan or ():
+        for arg in command.args:
+            if isinstance(arg, Quantity):
+                numbers.setdefault(arg.unit, set()).add(format_number(abs(arg.value)))
+    for value, unit in _NUMBER_UNIT.findall(convention.meaning):
+        if unit:
+            numbers.setdefault(unit, set()).add(value.lstrip("-"))
+    return numbers
 
 
 def _resolve_adapter(adapter: str | None, *, default_model: bool) -> Path | None:

@@ -43,7 +43,7 @@ def test_every_accepted_program_parses(profile: Profile, data: st.DataObject) ->
 
 
 def test_narrowing_limits_objects_and_numbers(profile: Profile) -> None:
-    automaton = RslAutomaton(profile, objects=["cup"], numbers={"2", "-2", "0"})
+    automaton = RslAutomaton(profile, objects=["cup"], numbers={"m": {"2", "-2", "0"}})
     assert automaton.accepts("grasp cup;\nforward 2;\ngoto -2, 0;\n\n")
     assert not automaton.accepts("grasp mug;\n\n")
     assert not automaton.accepts("forward 3;\n\n")
