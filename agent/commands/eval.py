@@ -23,6 +23,8 @@ def register(subparsers: Any) -> None:
                         help="only this group (repeatable): simple, ambiguous, multi-step, complex, units, "
                              "asr-noise")
     parser.add_argument("--limit", type=int, metavar="N", help="only the first N tasks (after --group)")
+    parser.add_argument("--every", type=int, default=1, metavar="K",
+                        help="only every K-th task, a quick sample across all groups (default: 1, all)")
     parser.add_argument("--holdout", choices=["all", "only", "exclude"], default="all",
                         help="tasks kept out of development: all (default), only those, or none of them")
     parser.add_argument("--suite", metavar="FILE", help="another suite file in the same format")
@@ -54,6 +56,8 @@ def _eval(args: argparse.Namespace) -> int:
         tasks = [t for t in tasks if t.group in args.group]
     if args.holdout != "all":
         tasks = [t for t in tasks if t.holdout == (args.holdout == "only")]
+    if args.every > 1:
+        tasks = tasks[:: args.every]
     if args.limit is not None:
         tasks = tasks[: max(0, args.limit)]
     if not tasks:
