@@ -124,7 +124,7 @@ def run(model_ref: str, language: str) -> dict[str, object]:
             per_mode[mode] = {
                 "wer": round(word_error_rate(refs, hypotheses), 4),
                 "exact_sentences": f"{exact}/{len(refs)}",
-                "final_result_ms_median": round(1000 * statistics.median(latencies), 1),
+                "final_result_ms_median": round(1000 * float(statistics.median(latencies)), 1),
             }
             if set_name != "commands_noisy_10db":
                 examples.setdefault(set_name, [{"said": r} for r in refs])
@@ -156,13 +156,15 @@ def live_latency(model_ref: str, language: str, silence_ms: int, runs: int) -> d
     wake = phrase.split()[0]
     heard: queue.Queue[tuple[float, str]] = queue.Queue()
     latencies, texts = [], []
+    events: list[str] = []
     with tempfile.TemporaryDirectory(prefix="nrtrans-bench-live-") as folder, VirtualMic() as mic:
         wav = speak(phrase, Path(folder) / "phrase.wav", VOICES[language])
         audio = read_wav(wav)
         loud = np.nonzero(np.abs(audio.samples) > 300)[0]
         speech_ends_s = (loud[-1] + 1) / audio.rate
         config = SpeechConfig(model=model_ref, language=language, wake_words=(wake,), silence_ms=silence_ms)
-        speech = SpeechInput(config, lambda t: heard.put((time.time(), t.text)))
+        speech = SpeechInput(config, lambda t: heard.put((time.time(), t.text)),
+                             lambda e: events.append(e.kind))
         speech.start()
         try:
             deadline = time.monotonic() + 60
@@ -173,7 +175,11 @@ def live_latency(model_ref: str, language: str, silence_ms: int, runs: int) -> d
             for _ in range(runs):
                 started = time.time()
                 mic.play(wav)
-                at, text = heard.get(timeout=20)
+                try:
+                    at, text = heard.get(timeout=20)
+                except queue.Empty:
+                    raise RuntimeError(f"no transcript for run {len(latencies) + 1} (silence_ms={silence_ms}); "
+                                       f"events {events}, health {speech.health()}") from None
                 latencies.append(at - (started + speech_ends_s))
                 texts.append(text)
                 time.sleep(0.5)
@@ -182,8 +188,8 @@ def live_latency(model_ref: str, language: str, silence_ms: int, runs: int) -> d
     return {
         "silence_ms": silence_ms,
         "runs": runs,
-        "end_of_speech_to_transcript_ms_median": round(1000 * statistics.median(latencies), 1),
-        "end_of_speech_to_transcript_ms_max": round(1000 * max(latencies), 1),
+        "end_of_speech_to_transcript_ms_median": round(1000 * float(statistics.median(latencies)), 1),
+        "end_of_speech_to_transcript_ms_max": round(1000 * float(max(latencies)), 1),
         "transcripts": sorted(set(texts)),
     }
 
