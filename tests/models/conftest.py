@@ -20,6 +20,8 @@ class Served:
     # Send only this many body bytes of the next response, then drop the
     # connection (while announcing the full length), like a network cut.
     cut_after: int | None = None
+    # Answer every request with the whole file, as servers without Range support do.
+    ignore_range: bool = False
     ranges_seen: list[str | None] = field(default_factory=list)
 
 
@@ -34,7 +36,7 @@ class _Handler(http.server.BaseHTTPRequestHandler):
             self.send_error(404)
             return
         start = 0
-        if header:
+        if header and not self.served.ignore_range:
             match = re.fullmatch(r"bytes=(\d+)-", header)
             if match is None:
                 self.send_error(400)

@@ -69,6 +69,17 @@ def test_interrupted_download_resumes_with_range(http_server, model_home: Path) 
     assert "MB" in progress.getvalue()
 
 
+def test_server_without_range_support_restarts_cleanly(http_server, model_home: Path) -> None:
+    base, served = http_server
+    served.files["/tiny.gguf"] = PAYLOAD
+    served.ignore_range = True
+    model_home.mkdir(parents=True)
+    (model_home / "tiny.gguf.part").write_bytes(PAYLOAD[:5000])
+    result = fetch(gguf_entry(f"{base}/tiny.gguf"), progress=None)
+    assert served.ranges_seen == ["bytes=5000-"]
+    assert result.path.read_bytes() == PAYLOAD, "a 200 answer to a Range request replaces the part file"
+
+
 def test_complete_part_file_is_accepted_after_416(http_server, model_home: Path) -> None:
     base, served = http_server
     served.files["/tiny.gguf"] = PAYLOAD
