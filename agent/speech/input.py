@@ -18,11 +18,13 @@ from dataclasses import dataclass
 from typing import Any
 
 from agent.speech.endpoint import SilenceDetector
+from agent.speech.feedback import Speaker, describe
 from agent.speech.lexicon import lexicon_for
 from agent.speech.recognizer import LoadedModel, load_model
 from agent.speech.records import SpeechConfig, SpeechEvent, Transcript, TranscriptSource
 from agent.speech.spotting import TimedRecognizer, WakeSpotter, trim_leading_quiet, words_after
 from agent.speech.vocabulary import UNKNOWN, Vocabulary
+from rsl.plan import Command
 
 log = logging.getLogger("nrtrans.speech")
 
@@ -73,6 +75,7 @@ class SpeechInput:
         self._transcripts = 0
         self._model: LoadedModel | None = None
         self._wake_words = tuple(w.lower() for w in config.wake_words)
+        self._speaker = Speaker(config.feedback_voice, enabled=config.feedback)
 
     # -- the public interface -------------------------------------------------------------
 
@@ -90,6 +93,7 @@ class SpeechInput:
         thread, self._thread = self._thread, None
         if thread is not None:
             thread.join(timeout)
+        self._speaker.close()
         if self.config.enabled:
             self._set_state("stopped")
 
@@ -102,6 +106,14 @@ class SpeechInput:
             raise SpeechUnavailable(f"speech input cannot listen now ({state}"
                                     f"{': ' + problem if problem else ''}); see `nrtrans health`")
         self._push_to_talk.set()
+
+    def announce(self, command: Command) -> bool:
+        """Say a plan step aloud when `feedback` is on; never blocks, never raises."""
+        try:
+            return self._speaker.speak(describe(command))
+        except Exception:
+            log.exception("spoken feedback failed for %s", command.skill)
+            return False
 
     def set_objects(self, names: tuple[str, ...] | list[str]) -> None:
         """Bias toward these object names from the next utterance on (e.g. after `perceive`)."""
@@ -124,6 +136,7 @@ class SpeechInput:
                 "wake_words": list(self._wake_words),
                 "dropped_blocks": self._dropped,
                 "transcripts": self._transcripts,
+                "feedback": {"on": self._speaker.enabled, "reason": self._speaker.reason},
             }
 
     # -- the worker -----------------------------------------------------------------------

@@ -44,6 +44,9 @@ class SpeechConfig:
     profile: str | None = None
     # How often to try again to open a missing or lost audio device.
     retry_s: float = 5.0
+    # Say each step aloud through espeak-ng ("moving forward two meters").
+    feedback: bool = False
+    feedback_voice: str = "en-us"
 
     @classmethod
     def from_dict(cls, options: dict[str, Any]) -> SpeechConfig:
@@ -68,6 +71,9 @@ class SpeechConfig:
         checks = (
             (isinstance(self.enabled, bool), "enabled must be true or false"),
             (isinstance(self.grammar_bias, bool), "grammar_bias must be true or false"),
+            (isinstance(self.feedback, bool), "feedback must be true or false"),
+            (isinstance(self.feedback_voice, str) and bool(self.feedback_voice),
+             "feedback_voice must be an espeak-ng voice name, like \"en-us\""),
             (self.model is None or isinstance(self.model, str), "model must be a name or a path"),
             (self.device is None or isinstance(self.device, str | int), "device must be a name or an index"),
             (isinstance(self.sample_rate, int) and 8000 <= self.sample_rate <= 48000,

@@ -179,3 +179,18 @@ def test_feedback_speaks_or_says_why_not(monkeypatch: pytest.MonkeyPatch, caplog
 def test_resample_identity_keeps_samples() -> None:
     samples = np.arange(100, dtype=np.int16)
     assert resample(Audio(samples, 16000), 16000).samples is samples
+
+
+def test_speech_input_announces_steps_only_when_asked(profile, monkeypatch: pytest.MonkeyPatch,
+                                                      audio_tools) -> None:
+    from agent.speech import SpeechInput
+
+    monkeypatch.setenv("PULSE_SERVER", "unix:/nonexistent")  # no sound reaches anyone during the test
+    plan = compile_program("turnleft 1.5708;", profile).plan
+    assert plan is not None
+    quiet = SpeechInput(SpeechConfig(enabled=False), lambda t: None)
+    assert not quiet.announce(plan.commands[0])
+    assert quiet.health()["feedback"] == {"on": False, "reason": "disabled in the config"}
+    talking = SpeechInput(SpeechConfig(enabled=False, feedback=True), lambda t: None)
+    assert talking.announce(plan.commands[0])
+    talking.stop()
