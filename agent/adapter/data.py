@@ -367,8 +367,7 @@ class Generator:
         if (style == "vague" and vague) or (style == "any" and vague and r < 0.12):
             amount = self.rng.choice(vague)
             return Clause(self._pick(VAGUE[key]).format(v=amount.phrase), (self._cmd(role, amount.value),))
-        if style == "bare" or (style == "any" and default is not None and r < 0.22):
-            assert default is not None
+        if default is not None and (style == "bare" or (style == "any" and r < 0.22)):
             return Clause(self._pick(BARE[key]), (self._cmd(role, default.value),))
         if role.kind == "drive":
             value = self._distance(role)
@@ -496,6 +495,8 @@ class Generator:
             return self._polygon(forward, turns)
         if r < 0.55 and turns:
             return self._full_circle(turns)
+        if not self.by_motion:
+            return None
         body = [self.motion(self._motion_role()) for _ in range(self.rng.choice((1, 2, 2)))]
         if self.rng.random() < 0.2 and self.first.get("perceive"):
             body.append(self.perceive() or body[0])
@@ -571,7 +572,7 @@ class Generator:
             clause = self.simple()
             group = "simple"
             text, commands = clause.text, list(clause.commands)
-        elif r < 0.4:
+        elif r < 0.4 and self.by_motion:
             role = self._motion_role()
             clause = self.motion(role, "vague" if self.rng.random() < 0.6 else "bare")
             text, commands, group = clause.text, list(clause.commands), "ambiguous"
@@ -584,7 +585,7 @@ class Generator:
             commands = [c for clause in clauses for c in clause.commands]
             group = "multi-step"
         elif r < 0.85:
-            clauses = self.fetch()
+            clauses = self.fetch() or [self.simple(), self.simple()]
             if self.rng.random() < 0.3:
                 clauses.insert(0, self.simple())
             text = self._join([c.text for c in clauses])
@@ -593,7 +594,8 @@ class Generator:
         else:
             repeated = self.repetition()
             if repeated is None:
-                return self.task()
+                clause = self.simple()
+                return self._surface(clause.text), list(clause.commands), "simple"
             text, commands = repeated
             if self.rng.random() < 0.25:
                 extra = self.origin() if self.rng.random() < 0.5 else self.simple()
