@@ -43,25 +43,28 @@ class VirtualMic:
         self.stop()
 
     def env(self) -> dict[str, str]:
-        """What a client process needs to reach this server (and nothing else)."""
-        return {"PULSE_SERVER": f"unix:{self.socket}", "PULSE_RUNTIME_PATH": str(self.folder / "runtime"),
-                "XDG_RUNTIME_DIR": str(self.folder / "runtime"), "PULSE_COOKIE": str(self.folder / "cookie")}
+        """What a client process needs to reach this server; set in os.environ while it runs."""
+        return {"PULSE_SERVER": f"unix:{self.socket}", "PULSE_COOKIE": str(self.folder / "cookie")}
 
     def start(self) -> None:
         runtime = self.folder / "runtime"
         runtime.mkdir(mode=0o700)
         home = self.folder / "home"
         home.mkdir()
-        for key, value in {**self.env(), "HOME": str(home)}.items():
+        for key, value in self.env().items():
             self._saved_env[key] = os.environ.get(key)
             os.environ[key] = value
-        log = (self.folder / "pulseaudio.log").open("wb")
-        self.server = subprocess.Popen(
-            ["pulseaudio", "--daemonize=no", "--exit-idle-time=-1", "--use-pid-file=no", "-n",
-             "--disable-shm=yes", f"--load=module-native-protocol-unix auth-anonymous=1 socket={self.socket}",
-             "--load=module-null-sink sink_name=virt rate=16000 channels=1",
-             "--log-target=stderr"],
-            stdout=log, stderr=log, env=os.environ.copy())
+        # The server's own files stay in the temporary folder; the test
+        # process keeps its HOME and runtime directory.
+        server_env = {**os.environ, "HOME": str(home), "XDG_RUNTIME_DIR": str(runtime),
+                      "PULSE_RUNTIME_PATH": str(runtime / "pulse")}
+        with (self.folder / "pulseaudio.log").open("wb") as log:
+            self.server = subprocess.Popen(
+                ["pulseaudio", "--daemonize=no", "--exit-idle-time=-1", "--use-pid-file=no", "-n",
+                 "--disable-shm=yes", f"--load=module-native-protocol-unix auth-anonymous=1 socket={self.socket}",
+                 "--load=module-null-sink sink_name=virt rate=16000 channels=1",
+                 "--log-target=stderr"],
+                stdout=log, stderr=log, env=server_env)
         deadline = time.monotonic() + 15
         while not self._ready():
             if self.server.poll() is not None or time.monotonic() > deadline:
