@@ -346,24 +346,42 @@ def _task_numbers(text: str, units: list[str]) -> dict[str, set[str]]:
     """Numbers the clause says, by unit; a number without a unit may be any unit."""
     numbers: dict[str, set[str]] = {}
     for value, unit in _NUMBER_UNIT.findall(text):
-        magnitude = value.lstrip("-")
         for target in [unit] if unit else units:
-            numbers.setdefault(target, set()).update({magnitude, "-" + magnitude})
+            numbers.setdefault(target, set()).update({value, value.lstrip("-")})
     return numbers
 
 
 def _convention_numbers(convention: Convention, profile: Profile) -> dict[str, set[str]]:
-    """The numbers, by unit, of a convention's program and its meaning text ("0.2 m ..., 0.2618 rad")."""
+    """The numbers of a convention, by unit or by `keyword:unit`.
+
+    They come from its program and from its meaning text, where a part like
+    "0.2618 rad (15 degrees) when turning or looking" applies to the skills
+    whose names start with "turn" or "look".
+    """
     numbers: dict[str, set[str]] = {}
     plan = compile_program(convention.program, profile).plan if convention.program else None
     for command in plan or ():
         for arg in command.args:
             if isinstance(arg, Quantity):
                 numbers.setdefault(arg.unit, set()).add(format_number(abs(arg.value)))
-    for value, unit in _NUMBER_UNIT.findall(convention.meaning):
-        if unit:
-            numbers.setdefault(unit, set()).add(value.lstrip("-"))
+    for part in convention.meaning.split(","):
+        found = _NUMBER_UNIT.search(part)
+        if found is None or not found.group(2):
+            continue
+        value, unit = found.group(1).lstrip("-"), found.group(2)
+        when = part.split(" when ", 1)[1] if " when " in part else ""
+        stems = [_stem(w) for w in re.findall(r"[a-z]+", when) if w not in ("or", "and")]
+        skills = [s.keyword for s in profile.skills
+                  if any(n.startswith(stem) for stem in stems for n in (s.keyword, *s.aliases))]
+        # The plain unit gets every value too, for skills no qualifier names.
+        for key in [*(f"{k}:{unit}" for k in skills), unit]:
+            numbers.setdefault(key, set()).add(value)
     return numbers
+
+
+def _stem(word: str) -> str:
+    """`turning` -> `turn`, `driving` -> `driv`: enough to match `drive` and `turnleft`."""
+    return word[:-3] if word.endswith("ing") and len(word) > 5 else word
 
 
 def _resolve_adapter(adapter: str | None, *, default_model: bool) -> Path | None:
