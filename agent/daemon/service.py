@@ -401,6 +401,9 @@ class Service:
                         ended = float(task.transcript["ended_at"])
                         task.timings_ms["speech_end_to_first_command_ms"] = round((time.time() - ended) * 1000, 3)
                 self.events.publish("executing", task.id, step=number, total=step.total, statement=step.statement)
+                if self.speech is not None:
+                    # Spoken feedback ("moving forward two meters") when [speech.options] feedback is on.
+                    self.speech.announce(plan.commands[step.index])
                 return
             outcome = {"status": step.outcome.status.value, "reason": step.outcome.reason}
             task.steps.append(
