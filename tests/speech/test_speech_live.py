@@ -68,3 +68,34 @@ def test_disabled_input_does_nothing(collector) -> None:
     with pytest.raises(SpeechUnavailable):
         speech.listen_now()
     speech.stop()
+
+
+def test_lone_wake_word_then_task_and_a_failing_handler(mic, say, tmp_path) -> None:
+    import queue
+
+    from agent.speech import SpeechEvent, Transcript
+
+    texts: queue.Queue[str] = queue.Queue()
+    kinds: list[str] = []
+
+    def handler(transcript: Transcript) -> None:
+        texts.put(transcript.text)
+        if texts.qsize() == 1:
+            raise RuntimeError("a handler bug must not stop the speech input")
+
+    def on_event(event: SpeechEvent) -> None:
+        kinds.append(event.kind)
+
+    speech = SpeechInput(SpeechConfig(**KOREAN), handler, on_event)
+    speech.start()
+    try:
+        wait_for(lambda: speech.health()["state"] == "waiting_for_wake_word", 30, "the wake-word state")
+        mic.play(say("로봇"))
+        wait_for(lambda: kinds.count("listening") >= 2, 10, "listening again for the task after a lone wake word")
+        mic.play(say("오른쪽 봐"))
+        assert texts.get(timeout=20) == "오른쪽 봐"
+        wait_for(lambda: speech.health()["state"] == "waiting_for_wake_word", 5, "the return to waiting")
+        mic.play(say("로봇 원점 이동"))
+        assert texts.get(timeout=20) == "원점 이동"
+    finally:
+        speech.stop()
