@@ -8,9 +8,11 @@ left" becomes two. Pronouns are resolved to the last named object, and
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
 
+from rsl.plan import format_number
 from rsl.profile import Profile
 
 _JOINERS = re.compile(r"\s*(?:,\s*and then|,\s*then|,\s*after that|,\s*afterwards|,\s*next|\band then\b|"
@@ -28,8 +30,16 @@ _NOT_OBJECTS = {"left", "right", "start", "origin", "beginning", "way", "same", 
 class Clause:
     text: str
     repeat: int = 1
-    # Repeat everything translated before this clause, `repeat` times in all.
+    # Repeat what was translated before this clause, `repeat` times in all:
+    # the last `span` clauses, or everything when `span` is 0.
     repeat_previous: bool = False
+    span: int = 0
+
+
+# A regular polygon is its sides repeated: drive a side, turn 2*pi/N.
+_SHAPES = {"triangle": 3, "square": 4, "pentagon": 5, "hexagon": 6, "octagon": 8}
+_SHAPE = re.compile(r"\b(?:a |an )?(" + "|".join(_SHAPES) + r")\b")
+_LENGTH = re.compile(r"(\d*\.?\d+) m\b")
 
 
 def split_clauses(task: str, profile: Profile) -> list[Clause]:
@@ -47,6 +57,10 @@ def split_clauses(task: str, profile: Profile) -> list[Clause]:
             part = _PRONOUN.sub(f"the {last_object}", part)
         if named:
             last_object = named[-1]
+        shape = _SHAPE.search(part)
+        if shape is not None:
+            clauses.extend(_polygon(part, _SHAPES[shape.group(1)]))
+            continue
         repeat_all = _REPEAT_ALL.match(part)
         if repeat_all and clauses:
             count = int(repeat_all.group("count") or 2)
@@ -58,6 +72,16 @@ def split_clauses(task: str, profile: Profile) -> list[Clause]:
         else:
             clauses.append(Clause(text=part))
     return clauses or [Clause(text=task)]
+
+
+def _polygon(text: str, sides: int) -> list[Clause]:
+    """`drive in a square with 2 m sides` -> drive 2 m, turn 1.5708 rad, both 4 times."""
+    length = _LENGTH.search(text)
+    side = length.group(1) if length else "1"
+    direction = "right" if re.search(r"\b(right|clockwise)\b", text) and "counter" not in text else "left"
+    angle = format_number(2 * math.pi / sides)
+    return [Clause(text=f"drive forward {side} m"), Clause(text=f"turn {direction} {angle} rad"),
+            Clause(text=text, repeat=sides, repeat_previous=True, span=2)]
 
 
 def _skill_words(profile: Profile) -> frozenset[str]:
@@ -74,7 +98,7 @@ def _split_commas_and_ands(text: str, verbs: frozenset[str]) -> list[str]:
     words = text.split(" ")
     parts: list[list[str]] = [[]]
     for index, word in enumerate(words):
-        following = words[index + 1] if index + 1 < len(words) else ""
+        following = words[index + 1].rstrip(",") if index + 1 < len(words) else ""
         if word == "and" and following in verbs and parts[-1]:
             parts.append([])
             continue

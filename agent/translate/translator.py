@@ -267,7 +267,7 @@ class Translator:
                          and (skill.keyword.startswith(w) or skill.keyword.endswith(w)))
             wanted_numbers = sum(1 for p in skill.params if p.kind == "number")
             if any(p.kind == "object" for p in skill.params) and has_object:
-                score += 1
+                score += 2
             if wanted_numbers >= 2:
                 score += 3 if numbers >= wanted_numbers else -5
             scores[skill.keyword] = score
@@ -332,10 +332,15 @@ def _tidy(text: str) -> str:
 def _assemble(states: list[_ClauseState]) -> str:
     """The whole program, recording which lines each clause produced."""
     program = ""
-    for state in states:
+    for index, state in enumerate(states):
         first = program.count("\n") + 1
         if state.clause.repeat_previous:
-            program = program * max(1, state.clause.repeat)
+            span = states[max(0, index - state.clause.span):index] if state.clause.span else states[:index]
+            block = "".join(s.program * max(1, s.clause.repeat) for s in span
+                            if not s.clause.repeat_previous)
+            kept = program[: len(program) - len(block)] if block and program.endswith(block) else program
+            body = block if state.clause.span else program
+            program = (kept if state.clause.span else "") + body * max(1, state.clause.repeat)
         else:
             program += state.program * max(1, state.clause.repeat)
         state.lines = (first, program.count("\n"))

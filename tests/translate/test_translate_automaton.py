@@ -71,3 +71,6 @@ def test_clauses_split_on_actions_not_on_coordinates(profile: Profile) -> None:
     assert pronoun[1].text == "pick the red cup up"
     repeat = split_clauses("drive forward 1 m and turn left 1.5708 rad, repeat 4 times", profile)
     assert repeat[-1].repeat_previous and repeat[-1].repeat == 4
+    square = split_clauses("go to 1, 1, perceive, then drive in a square with 2 m sides", profile)
+    assert [c.text for c in square[:4]] == ["go to 1, 1", "perceive", "drive forward 2 m", "turn left 1.5708 rad"]
+    assert square[-1].repeat_previous and square[-1].repeat == 4 and square[-1].span == 2
