@@ -15,6 +15,7 @@ import json
 import os
 import platform
 import resource
+import shutil
 import signal
 import statistics
 import subprocess
@@ -24,10 +25,11 @@ import time
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
+SCRATCH = tempfile.mkdtemp(prefix="nrtrans-bench-ros-")
 os.environ.update({
     "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
     "ROS_DOMAIN_ID": str(100 + os.getpid() % 130),
-    "ROS_LOG_DIR": tempfile.mkdtemp(prefix="nrtrans-bench-ros-"),
+    "ROS_LOG_DIR": SCRATCH,
 })
 sys.path.insert(0, str(REPO))
 
@@ -129,6 +131,7 @@ def main() -> int:
             bridge.wait(timeout=15)
         except subprocess.TimeoutExpired:
             bridge.kill()
+        shutil.rmtree(SCRATCH, ignore_errors=True)
 
     results = {
         "benchmark": "ros2",

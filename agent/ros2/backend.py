@@ -33,7 +33,6 @@ CONTROL_PERIOD = 0.02  # s, 50 Hz: well inside the 0.2 s the robot has to stop a
 LINEAR_TOLERANCE = 0.002  # m; the contract is 2 cm, the rest is margin for coasting
 ANGULAR_TOLERANCE = math.radians(0.15)  # the contract is 1 degree
 GOAL_GIVE_UP = 2.0  # s standing still short of a goal, after moving, before the step fails
-GOAL_HEADING_TOLERANCE = math.radians(2.0)
 JOINT_TOLERANCE = 0.01  # rad, or m for the gripper
 STILL_LINEAR = 0.01  # m/s; slower than this counts as standing still
 STILL_ANGULAR = 0.02  # rad/s
@@ -96,7 +95,7 @@ class Ros2Robot:
             start = self._fresh_odometry().pose
             far = math.hypot(x - start.x, y - start.y)
             heading = math.atan2(y - start.y, x - start.x) if far > self.config.goal_tolerance else start.heading
-            self._drive_to_goal(x, y, heading, token, check_heading=False)
+            self._drive_to_goal(x, y, heading, token)
             return Outcome.done()
         return self._guarded(cancel, run)
 
@@ -109,7 +108,14 @@ class Ros2Robot:
             standoff = self.profile.motion.standoff + self._edge(name, heading + math.pi)
             x, y = ox - standoff * math.cos(heading), oy - standoff * math.sin(heading)
             self._check_workspace(x, y, f"the stand-off point in front of {name}")
-            self._drive_to_goal(x, y, heading, token, check_heading=True)
+            self._drive_to_goal(x, y, heading, token)
+            # Navigation stacks settle headings loosely (Nav2: 0.25 rad by default), so the
+            # final turn to face the object is closed loop on odometry like any turn.
+            here = self._fresh_odometry().pose
+            facing = math.atan2(oy - here.y, ox - here.x)
+            error = wrap_angle(facing - here.heading)
+            if abs(error) > ANGULAR_TOLERANCE:
+                self._turn(abs(error), math.copysign(1.0, error), token)
             return Outcome.done(f"stopped {self.profile.motion.standoff:g} m in front of {name}, facing it")
         return self._guarded(cancel, run)
 
@@ -314,8 +320,9 @@ class Ros2Robot:
                 self._link.send_twist(linear, angular)
             token.wait(CONTROL_PERIOD)
 
-    def _drive_to_goal(self, x: float, y: float, heading: float, token: CancelToken,
-                       check_heading: bool) -> None:
+    def _drive_to_goal(self, x: float, y: float, heading: float, token: CancelToken) -> None:
+        """Send a goal pose and wait until odometry shows the base there and still; the
+        heading is a hint for the navigation stack, not part of arriving."""
         self._require_listener(lambda: self._link.listeners("goal"), self.config.goal_pose)
         start = self._fresh_odometry().pose
         far = math.hypot(x - start.x, y - start.y)
@@ -338,8 +345,7 @@ class Ros2Robot:
                 off = math.hypot(x - odom.pose.x, y - odom.pose.y)
                 turned = abs(wrap_angle(heading - odom.pose.heading))
                 still = abs(odom.linear) < STILL_LINEAR and abs(odom.angular) < STILL_ANGULAR
-                facing = not check_heading or turned <= GOAL_HEADING_TOLERANCE
-                if off <= tolerance and still and facing:
+                if off <= tolerance and still:
                     reached = True
                     return
                 moved = moved or not still

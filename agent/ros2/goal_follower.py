@@ -17,6 +17,10 @@ HEADING_TOLERANCE = math.radians(0.3)
 REALIGN_DISTANCE = 0.05  # m; drifting this far while turning on the spot restarts the drive
 DRIVE_HEADING_ERROR = 0.35  # rad; turn on the spot first when further off than this
 GAIN = 3.0  # 1/s
+# A new goal this close to the robot's pose means "stop here", the way clients cancel
+# a goal: the robot stops at once instead of creeping back to where the goal was sent.
+HOLD_DISTANCE = 0.02  # m
+HOLD_ANGLE = math.radians(5.0)
 
 
 @dataclass(frozen=True)
@@ -31,11 +35,13 @@ class GoalFollower:
         self.motion = motion
         self.goal: Goal | None = None
         self._aligning = False
+        self._new = False
         self._command = (0.0, 0.0)
 
     def set(self, goal: Goal) -> None:
         self.goal = goal
         self._aligning = False
+        self._new = True
 
     def clear(self) -> None:
         self.goal = None
@@ -49,6 +55,11 @@ class GoalFollower:
         motion = self.motion
         dx, dy = goal.x - pose.x, goal.y - pose.y
         far = math.hypot(dx, dy)
+        if self._new:
+            self._new = False
+            if far <= HOLD_DISTANCE and abs(wrap_angle(goal.heading - pose.heading)) <= HOLD_ANGLE:
+                self.clear()
+                return 0.0, 0.0
         if self._aligning and far > REALIGN_DISTANCE:
             self._aligning = False
         if not self._aligning and far > POSITION_TOLERANCE:

@@ -6,6 +6,7 @@ what goes over the wire (every Twist on cmd_vel, every odometry message).
 from __future__ import annotations
 
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -21,12 +22,15 @@ import pytest
 
 pytest.importorskip("rclpy", reason="ROS 2 wheels are not installed (pip install 'nrtrans[ros]')")
 
+REPO = Path(__file__).resolve().parents[2]
+
 # Every ROS participant of this test process, and the bridges it starts, live in
 # one domain that no other test run on this machine uses, on loopback only.
+SCRATCH = Path(tempfile.mkdtemp(prefix="nrtrans-ros-tests-"))
 ROS_ENV = {
     "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
     "ROS_DOMAIN_ID": str(100 + os.getpid() % 130),
-    "ROS_LOG_DIR": tempfile.mkdtemp(prefix="nrtrans-ros-log-"),
+    "ROS_LOG_DIR": str(SCRATCH / "ros-log"),
 }
 os.environ.update(ROS_ENV)
 
@@ -34,8 +38,6 @@ from agent.ros2.backend import Ros2Robot  # noqa: E402
 from agent.ros2.bridge import RESET_SERVICE  # noqa: E402
 from agent.ros2.node_thread import NodeThread  # noqa: E402
 from rsl.profile import Profile  # noqa: E402
-
-REPO = Path(__file__).resolve().parents[2]
 
 
 @dataclass(frozen=True)
@@ -115,7 +117,7 @@ class Bridge:
     """`nrtrans sim-bridge` in its own process."""
 
     def __init__(self, realtime_factor: float = 1.0, *extra: str) -> None:
-        self.log = Path(tempfile.mkdtemp(prefix="nrtrans-sim-bridge-")) / "bridge.log"
+        self.log = Path(tempfile.mkdtemp(prefix="sim-bridge-", dir=SCRATCH)) / "bridge.log"
         with self.log.open("wb") as log:
             self.process = subprocess.Popen(
                 [sys.executable, "-m", "agent.cli", "sim-bridge", "--realtime-factor", str(realtime_factor),
@@ -142,6 +144,12 @@ class Bridge:
     def kill(self) -> None:
         self.process.kill()
         self.process.wait()
+
+
+@pytest.fixture(scope="session", autouse=True)
+def scratch_cleanup() -> Iterator[None]:
+    yield
+    shutil.rmtree(SCRATCH, ignore_errors=True)
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -174,6 +182,11 @@ def robot(bridge: Bridge, probe: Probe, profile: Profile) -> Iterator[Ros2Robot]
     probe.reset_world()
     robot = Ros2Robot(profile, connect_timeout=30.0)
     probe.wait_for_publisher("/cmd_vel")
+    # The probe must be matched to the backend's cmd_vel, or it misses the first commands.
+    deadline = time.monotonic() + 20.0
+    while robot._link.listeners("cmd_vel") < 2:
+        assert time.monotonic() < deadline, "the probe never matched the backend's cmd_vel"
+        time.sleep(0.02)
     yield robot
     robot.close()
     assert bridge.process.poll() is None or bridge.process.returncode == 0, bridge.output()

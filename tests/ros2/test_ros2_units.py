@@ -110,8 +110,11 @@ def test_a_goal_at_the_robots_own_pose_stops_it_at_once(profile: Profile) -> Non
     follower.set(Goal(-0.03, 0.0, 0.0))
     linear, _ = follower.command(Pose(0.0, 0.0, 0.0), 0.02)
     assert -0.021 <= linear <= 0.0
-    follower.set(Goal(0.0, 0.0, 0.0))
+    # The cancel idiom: a goal where the robot was a moment ago, heading slightly off,
+    # stops it where it is instead of turning it back.
+    follower.set(Goal(-0.01, 0.0, math.radians(3.0)))
     assert follower.command(Pose(0.0, 0.0, 0.0), 0.02) == (0.0, 0.0)
+    assert follower.goal is None
 
 
 def test_geometry_helpers() -> None:
