@@ -393,7 +393,7 @@ class Service:
 
     def _execute(self, task: Task, plan: Any, start: float) -> None:
         def on_step(step: Any) -> None:
-            number = step.index + 1
+            number = step.index  # 1-based
             if step.outcome is None:
                 if "first_command_ms" not in task.timings_ms:
                     task.mark("first_command_ms", start)
@@ -403,7 +403,7 @@ class Service:
                 self.events.publish("executing", task.id, step=number, total=step.total, statement=step.statement)
                 if self.speech is not None:
                     # Spoken feedback ("moving forward two meters") when [speech.options] feedback is on.
-                    self.speech.announce(plan.commands[step.index])
+                    self.speech.announce(plan.commands[number - 1])
                 return
             outcome = {"status": step.outcome.status.value, "reason": step.outcome.reason}
             task.steps.append(
