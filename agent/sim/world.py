@@ -20,10 +20,12 @@ from __future__ import annotations
 
 import math
 import os
+import sys
 import tempfile
 import time
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -151,6 +153,19 @@ def _robot_urdf(profile: Profile) -> str:
 """
 
 
+@contextmanager
+def _stdout_to_stderr() -> Iterator[None]:
+    """pybullet's C code prints a banner on connect; keep it off stdout, which may carry JSON."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        os.dup2(2, 1)
+        yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
 def _wrap(angle: float) -> float:
     return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
@@ -174,7 +189,8 @@ class SimWorld:
         self._head_target = (0.0, 0.0)
         self._grip_constraint: int | None = None
         self._wall_start = time.monotonic()
-        self._client = BulletClient(connection_mode=pybullet.DIRECT)
+        with _stdout_to_stderr():
+            self._client = BulletClient(connection_mode=pybullet.DIRECT)
         self._closed = False
         client = self._client
         client.setAdditionalSearchPath(pybullet_data.getDataPath())
@@ -235,6 +251,10 @@ class SimWorld:
     def add_listener(self, listener: Callable[[SimWorld], None]) -> None:
         """Call `listener(world)` after every physics step (recorders use this)."""
         self._listeners.append(listener)
+
+    def remove_listener(self, listener: Callable[[SimWorld], None]) -> None:
+        if listener in self._listeners:
+            self._listeners.remove(listener)
 
     def step(self, n: int = 1) -> None:
         """Advance the physics by `n` steps of `dt`, sleeping to honour the real-time factor."""
@@ -421,6 +441,16 @@ class SimWorld:
         view = self._client.computeViewMatrix(eye.tolist(), (eye + forward).tolist(), up.tolist())
         projection = self._client.computeProjectionMatrixFOV(math.degrees(CAMERA_VFOV), width / height,
                                                              0.05, CAMERA_RANGE * 2)
+        _, _, rgba, _, _ = self._client.getCameraImage(width, height, view, projection,
+                                                       renderer=pybullet.ER_TINY_RENDERER)
+        return np.asarray(rgba, dtype=np.uint8).reshape(height, width, 4)[:, :, :3]
+
+    def overview_image(self, width: int = 320, height: int = 240, *, distance: float = 5.0,
+                       yaw: float = -60.0, pitch: float = -45.0) -> np.ndarray:
+        """A third-person view of the robot and what is around it, for animations of a run."""
+        pose = self.base_pose()
+        view = self._client.computeViewMatrixFromYawPitchRoll([pose.x, pose.y, 0.3], distance, yaw, pitch, 0, 2)
+        projection = self._client.computeProjectionMatrixFOV(60.0, width / height, 0.1, 50.0)
         _, _, rgba, _, _ = self._client.getCameraImage(width, height, view, projection,
                                                        renderer=pybullet.ER_TINY_RENDERER)
         return np.asarray(rgba, dtype=np.uint8).reshape(height, width, 4)[:, :, :3]
