@@ -49,6 +49,8 @@ class StepFailure(Exception):
 
 
 class Ros2Robot:
+    backend_name = "ros2"
+
     def __init__(self, profile: Profile, *, config: RosConfig | None = None,
                  node_name: str = "nrtrans_backend", connect_timeout: float | None = None) -> None:
         self.profile = profile

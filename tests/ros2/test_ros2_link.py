@@ -11,6 +11,7 @@ import time
 
 import pytest
 
+from agent.backends import open_robot
 from agent.robot import Outcome, Status
 from agent.ros2.backend import RobotUnavailable, Ros2Robot
 from agent.ros2.config import RosConfig
@@ -28,7 +29,7 @@ def test_no_robot_at_all_is_a_clear_error_not_a_hang(profile: Profile) -> None:
     config = dataclasses.replace(RosConfig.from_profile(profile), **ros)
     started = time.monotonic()
     with pytest.raises(RobotUnavailable) as error:
-        Ros2Robot(profile, config=config, connect_timeout=1.0)
+        open_robot("ros2", profile, config=config, connect_timeout=1.0)
     assert time.monotonic() - started < 5.0
     message = str(error.value)
     assert "no odometry arrived on /absent/odom within 1 s" in message

@@ -8,10 +8,10 @@ from dataclasses import dataclass
 
 import pytest
 
+from agent.executor import execute
 from agent.robot import CancelToken, Outcome, RobotState
 from agent.ros2.backend import Ros2Robot
 from rsl.compiler import compile_program
-from rsl.plan import ObjectRef
 from rsl.profile import Profile
 
 REALTIME_FACTOR = 2.0
@@ -39,17 +39,16 @@ SCENARIOS = [
 ]
 
 
-def run_program(robot: Ros2Robot, profile: Profile, program: str) -> tuple[RobotState, list[Outcome]]:
+def run_program(robot: Ros2Robot, profile: Profile, program: str) -> tuple[RobotState, tuple[Outcome, ...]]:
+    """Compile and run through the real executor, watchdog included, as the daemon does."""
     result = compile_program(program, profile)
     assert result.ok, [d.brief() for d in result.diagnostics]
     assert result.plan is not None
-    outcomes = []
-    for command in result.plan:
-        args = [a.name if isinstance(a, ObjectRef) else a.value for a in command.args]
-        outcome = getattr(robot, command.skill)(*args, cancel=CancelToken())
-        assert outcome.ok, f"`{command.to_rsl()}` {outcome.status.value}: {outcome.reason}"
-        outcomes.append(outcome)
-    return robot.state(), outcomes
+    run = execute(result.plan, robot, profile, cancel=CancelToken())
+    failed = [(c.to_rsl(), o.reason) for c, o in zip(result.plan, run.outcomes, strict=False) if not o.ok]
+    assert run.ok, failed
+    assert run.final_state is not None
+    return run.final_state, run.outcomes
 
 
 @pytest.mark.parametrize("scenario", SCENARIOS, ids=lambda s: s.name)
