@@ -117,8 +117,10 @@ class RslAutomaton:
             return frozenset()
         signed = self._number_shape[(keyword, index)][1]
         unit = self.skills[keyword].params[index].unit
-        # "keyword:unit" narrows one skill further ("0.2618 rad when turning").
-        allowed = self.numbers.get(f"{keyword}:{unit}") or self.numbers.get(unit, frozenset())
+        # "keyword#index" pins one argument (the x of `goto`), "keyword:unit"
+        # narrows one skill ("0.2618 rad when turning"); the unit is the fallback.
+        allowed = (self.numbers.get(f"{keyword}#{index}") or self.numbers.get(f"{keyword}:{unit}")
+                   or self.numbers.get(unit, frozenset()))
         return frozenset(n for n in allowed if signed or (not n.startswith("-") and float(n) > 0))
 
     def _param_done(self, keyword: str, index: int, char: str) -> State | None:

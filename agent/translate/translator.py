@@ -210,6 +210,13 @@ class Translator:
             # numbers are only for vague clauses. Polygon turns stay for both.
             said = _task_numbers(state.clause.text, self._units)
             numbers = said if said else self._vague_numbers(state.clause.text)
+            values = _NUMBER.findall(state.clause.text)
+            for skill in self.profile.skills:
+                # "go to -2, 1.5": the said numbers fill a multi-number skill in order.
+                positions = [i for i, p in enumerate(skill.params) if p.kind == "number"]
+                if len(positions) >= 2 and len(values) == len(positions):
+                    for position, value in zip(positions, values, strict=True):
+                        numbers[f"{skill.keyword}#{position}"] = {value}
         cap = state.max_statements or (CLAUSE_STATEMENTS if self.options.split_clauses else None)
         number_key = None if numbers is None else tuple(sorted((u, frozenset(v)) for u, v in numbers.items()))
         key = (state.objects, number_key, state.keywords, cap)
