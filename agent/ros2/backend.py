@@ -98,7 +98,8 @@ class Ros2Robot:
             far = math.hypot(x - start.x, y - start.y)
             heading = math.atan2(y - start.y, x - start.x) if far > self.config.goal_tolerance else start.heading
             self._drive_to_goal(x, y, heading, token)
-            return Outcome.done()
+            here = self._fresh_odometry().pose
+            return Outcome.done(f"at ({here.x:.2f}, {here.y:.2f})")
         return self._guarded(cancel, run)
 
     def approach(self, name: str, *, cancel: CancelToken | None = None) -> Outcome:
