@@ -138,6 +138,10 @@ class SimRobot:
             positions = world.objects()
             ox, oy, _ = positions[name]
             away = math.hypot(ox - here.x, oy - here.y)
+            reach = self.profile.motion.reach
+            if away > reach:
+                return Outcome.failed(f"{name} is {away:.2f} m away, out of reach {reach:g} m; "
+                                      f"`approach {name};` first")
             for other, (x, y, _z) in positions.items():
                 obj = world.scene.object(other)
                 if (other not in (name, world.holding) and obj is not None and obj.graspable
@@ -285,7 +289,8 @@ class SimRobot:
                 if abs(linear) < STILL_LINEAR and abs(angular) < STILL_ANGULAR:
                     world.set_base_velocity(0.0, 0.0)
                     return
-                speed = 0.0
+                # Inside the tolerance: brake within the profile's acceleration, not the motors' own.
+                speed = self._profile_speed(0.0, speed, top, accel, CREEP[unit])
             else:
                 speed = self._profile_speed(left, speed, top, accel, CREEP[unit])
             world.set_base_velocity(*command(speed))
