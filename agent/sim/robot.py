@@ -134,6 +134,9 @@ class SimRobot:
                 return Outcome.failed(f"cannot grasp {name}: already holding {world.holding}; "
                                       "the gripper holds one object at a time")
             self._known_position(name)
+            target = world.scene.object(name)
+            if target is not None and not target.graspable:
+                return Outcome.failed(f"the {name} is {target.kind} ({target.mass:g} kg) and cannot be picked up")
             here = world.base_pose()
             positions = world.objects()
             ox, oy, _ = positions[name]
