@@ -185,6 +185,7 @@ class SimWorld:
         self.trajectory: deque[Sample] = deque(maxlen=TRAJECTORY_LIMIT)
         self._listeners: list[Callable[[SimWorld], None]] = []
         self._command = (0.0, 0.0)
+        self._pose: Pose | None = None
         self._velocity = (0.0, 0.0)
         self._head_target = (0.0, 0.0)
         self._grip_constraint: int | None = None
@@ -262,6 +263,7 @@ class SimWorld:
         for _ in range(n):
             self._apply_base_velocity()
             client.stepSimulation()
+            self._pose = None
             self.sim_time += self.dt
             if self.realtime_factor > 0:
                 ahead = self._wall_start + self.sim_time / self.realtime_factor - time.monotonic()
@@ -303,9 +305,12 @@ class SimWorld:
                          max(-motion.max_angular_speed, min(motion.max_angular_speed, angular)))
 
     def base_pose(self) -> Pose:
-        position, orientation = self._client.getBasePositionAndOrientation(self._robot)
-        yaw = self._client.getEulerFromQuaternion(orientation)[2]
-        return Pose(position[0], position[1], yaw)
+        # Cached per physics step: the control loops ask several times between two steps.
+        if self._pose is None:
+            position, orientation = self._client.getBasePositionAndOrientation(self._robot)
+            yaw = self._client.getEulerFromQuaternion(orientation)[2]
+            self._pose = Pose(position[0], position[1], yaw)
+        return self._pose
 
     def base_velocity(self) -> tuple[float, float]:
         """Measured (linear, angular) velocity in the body frame."""
