@@ -24,6 +24,9 @@ def add_model_options(parser: argparse.ArgumentParser) -> None:
                         help="sample without the RSL grammar (the unconstrained setting, for comparison)")
     parser.add_argument("--shots", type=int, default=None, metavar="N",
                         help="worked examples in the prompt (default: 4 without an adapter, 0 with one)")
+    parser.add_argument("--shots-in-prefix", action="store_true",
+                        help="put every worked example in the fixed, cached prompt prefix (fast: a request "
+                             "only evaluates its task), with --shots N similar ones after it")
     parser.add_argument("--no-split", action="store_true",
                         help="translate the task in one go instead of clause by clause")
     parser.add_argument("--no-narrow", action="store_true",
@@ -43,7 +46,8 @@ def load_translator(args: argparse.Namespace) -> Any:
     profile = load_profile(args.profile)
     return Translator.load(profile, model=args.model, adapter=args.adapter, grammar=not args.no_grammar,
                            max_passes=args.max_passes, endpoint=args.endpoint, shots=args.shots,
-                           split_clauses=not args.no_split, narrow=not args.no_narrow)
+                           split_clauses=not args.no_split, narrow=not args.no_narrow,
+                           prefix_shots=args.shots_in_prefix)
 
 
 def register(subparsers: Any) -> None:

@@ -67,6 +67,9 @@ class Options:
     grammar: bool = True
     max_passes: int = 3
     shots: int = DEFAULT_SHOTS
+    # The whole shot bank inside the fixed, KV-cached prefix, so a request
+    # evaluates only its own task; `shots` similar ones may still follow.
+    prefix_shots: bool = False
     split_clauses: bool = True
     narrow: bool = True
     adapter_prompt: bool = False
@@ -96,6 +99,7 @@ class Translator:
         self._lock = threading.Lock()
         self._system = system_text(profile)
         self._bank: tuple[Shot, ...] = load_shots(profile)
+        self._bank_text = "".join(f"Task: {s.task}\nRSL:\n{s.program}\n" for s in self._bank)
         self._units = sorted({p.unit for s in profile.skills for p in s.params if p.kind == "number"})
         self._conventions = [(c, _convention_numbers(c, profile)) for c in profile.conventions]
         self._automata: dict[Any, RslAutomaton] = {}
@@ -103,7 +107,7 @@ class Translator:
     @classmethod
     def load(cls, profile: Profile, *, model: str | None = None, adapter: str | None = None,
              grammar: bool = True, max_passes: int = 3, endpoint: str | None = None, shots: int | None = None,
-             split_clauses: bool = True, narrow: bool = True) -> Translator:
+             split_clauses: bool = True, narrow: bool = True, prefix_shots: bool = False) -> Translator:
         """Load the model (or connect to `endpoint`).
 
         `adapter`: None picks the shipped adapter for the embedded default
@@ -129,7 +133,8 @@ class Translator:
         use_adapter = lora is not None
         options = Options(grammar=grammar, max_passes=max_passes,
                           shots=(0 if use_adapter else DEFAULT_SHOTS) if shots is None else shots,
-                          split_clauses=split_clauses, narrow=narrow, adapter_prompt=use_adapter)
+                          split_clauses=split_clauses, narrow=narrow, adapter_prompt=use_adapter,
+                          prefix_shots=prefix_shots and not use_adapter)
         return cls(profile, engine, name, options)
 
     def close(self) -> None:
@@ -199,6 +204,8 @@ class Translator:
                 bos = llm.detokenize([llm.token_bos()]).decode("utf-8", "replace")
                 eos = llm.detokenize([llm.token_eos()]).decode("utf-8", "replace")
             return chat_prompt(self.engine.chat_template, bos, eos, self._system, shots, text) + extra
+        if self.options.prefix_shots:
+            return completion_prompt(self._system + self._bank_text, shots, text) + extra
         return completion_prompt(self._system, shots, text) + extra
 
     def _automaton(self, state: _ClauseState) -> RslAutomaton | None:
