@@ -39,5 +39,5 @@ def open_robot(backend: str, profile: Profile, *, scene: str | Path | None = Non
                 "  hint: pip install 'nrtrans[ros]' (x86_64), or source your ROS 2 setup.bash (Jazzy or Kilted) "
                 "before starting nrtrans; or use --backend sim"
             ) from exc
-        return Ros2Robot(profile, **options)  # type: ignore[no-any-return]
+        return Ros2Robot(profile, **options)
     raise BackendError(f"unknown backend {backend!r}: choose one of {', '.join(BACKENDS)}")

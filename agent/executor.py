@@ -89,9 +89,8 @@ def step_timeout(command: Command, profile: Profile, start: RobotState | None = 
         # A final turn-in-place may follow when the robot reverses onto the point.
         return drive_time(distance, profile) + margin
     if skill == "approach":
-        distance = _distance_to_known(command.object(0), start.pose, start) if start is not None else None
-        if distance is None:
-            distance = _workspace_diagonal(profile)
+        known = _distance_to_known(command.object(0), start.pose, start) if start is not None else None
+        distance = known if known is not None else _workspace_diagonal(profile)
         # Two turns: to face the stand-off point, then to face the object.
         return drive_time(distance, profile) + travel_time(math.pi, motion.max_angular_speed,
                                                            motion.max_angular_accel) + margin

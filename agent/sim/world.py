@@ -356,8 +356,11 @@ class SimWorld:
 
     def objects(self) -> dict[str, tuple[float, float, float]]:
         """Ground-truth positions of every named object."""
-        return {name: tuple(self._client.getBasePositionAndOrientation(uid)[0])  # type: ignore[misc]
-                for name, uid in self._bodies.items()}
+        positions = {}
+        for name, uid in self._bodies.items():
+            x, y, z = self._client.getBasePositionAndOrientation(uid)[0]
+            positions[name] = (float(x), float(y), float(z))
+        return positions
 
     def camera_pose(self) -> tuple[np.ndarray, np.ndarray]:
         """The camera's position and its rotation matrix (columns: forward, left, up)."""
