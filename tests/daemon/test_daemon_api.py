@@ -270,6 +270,8 @@ def test_a_client_that_stops_reading_is_cut_off_without_blocking_others(daemon: 
 
 
 def test_socket_is_0660_and_the_allow_list_refuses_strangers(workdir: Path) -> None:
+    if os.geteuid() != 0:
+        pytest.skip("connecting as another user (nobody) needs root to switch users")
     daemon = Daemon(workdir, {"api": {"socket_mode": "0666", "allowed_uids": [4242]}}).start()
     try:
         assert oct(daemon.socket.stat().st_mode & 0o777) == "0o666"
