@@ -171,7 +171,7 @@ class SimRobot:
             head_pan=sample.pan,
             head_tilt=sample.tilt,
             holding=self.world.holding,
-            known_objects=tuple((n, x, y) for n, (x, y) in sorted(self._known.items())),
+            known_objects=tuple((n, x, y) for n, (x, y) in sorted(dict(self._known).items())),
         )
 
     def close(self) -> None:
