@@ -165,7 +165,7 @@ def _run_step(command: Command, statement: str, robot: Robot, profile: Profile,
     def forward_cancel() -> None:
         # The caller's token and the watchdog both end the step through one token.
         while not step_token.is_set():
-            if cancel.wait(0.02):
+            if cancel.wait(0.01):
                 step_token.set(cancel.reason or "cancelled")
                 return
 

@@ -109,3 +109,19 @@ def test_grasped_object_travels_with_the_robot(robot: SimRobot) -> None:
     pose = robot.state().pose
     assert math.hypot(cx - pose.x, cy - pose.y) < 0.5
     assert cz > 0.7  # still up in the gripper, not dropped on the floor
+
+
+def test_approach_from_too_close_backs_up_and_twice_is_a_no_op(robot: SimRobot) -> None:
+    assert robot.perceive().ok and robot.approach("table").ok
+    there = robot.state().pose
+    assert robot.approach("table").ok
+    again = robot.state().pose
+    assert math.hypot(again.x - there.x, again.y - there.y) < 0.005
+    assert robot.forward(0.2).ok
+    assert robot.approach("table").ok
+    back = robot.state().pose
+    assert math.hypot(back.x - there.x, back.y - there.y) < 0.01
+    assert abs(math.remainder(back.heading - there.heading, 2 * math.pi)) < math.radians(1.0)
+    # It backed straight up rather than turning round in front of the table.
+    assert min(abs(math.remainder(s.heading, 2 * math.pi)) for s in list(robot.world.trajectory)[-200:]) < 0.05
+    assert max(abs(math.remainder(s.heading, 2 * math.pi)) for s in list(robot.world.trajectory)[-200:]) < 0.05
