@@ -16,11 +16,12 @@ EXIT_DONE, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 def register(subparsers: Any) -> None:
     parser = subparsers.add_parser(
         "run-program", help="verify an RSL program and run it on the simulator or a robot",
-        description="Compile an RSL program against the robot profile and, only if it verifies, run it "
-                    "step by step on a backend: `sim` (a headless pybullet robot) or `ros2` (a robot, or "
-                    "`nrtrans sim-bridge`, over ROS 2). Progress goes to standard error. Exit status: "
-                    "0 every step done, 1 the program does not verify or a step failed or was cancelled "
-                    "(SIGINT/SIGTERM stop the robot and cancel), 2 usage error.",
+        description="Compile an RSL program against the robot profile and, only if it verifies, run it\n"
+                    "step by step on a backend: `sim` (a headless pybullet robot) or `ros2` (a robot,\n"
+                    "or `nrtrans sim-bridge`, over ROS 2). Progress goes to standard error.\n\n"
+                    "Exit status: 0 every step done; 1 the program does not verify, a step failed, or\n"
+                    "the run was cancelled (SIGINT/SIGTERM stop the robot); 2 usage error or a backend\n"
+                    "that cannot be opened. More in docs/simulator.md.",
         epilog="Examples:\n"
                "  nrtrans run-program task.rsl --record runs/one --gif\n"
                "  nrtrans run-program task.rsl --backend ros2 --dry-run --json\n"
