@@ -65,8 +65,8 @@ def load(model: Path, adapter: Path | None, threads: int | None = None) -> Any:
     return open_llama(model, n_ctx=512, lora_path=adapter, n_threads=threads)
 
 
-def complete(llm: Any, prompt: str, grammar: Any = None) -> str:
-    out = llm.create_completion(prompt, max_tokens=MAX_TOKENS, temperature=0.0, top_k=1, stop=["\n\n"],
+def complete(llm: Any, prompt: str, grammar: Any = None, max_tokens: int = MAX_TOKENS) -> str:
+    out = llm.create_completion(prompt, max_tokens=max_tokens, temperature=0.0, top_k=1, stop=["\n\n"],
                                 grammar=grammar)
     return str(out["choices"][0]["text"])
 

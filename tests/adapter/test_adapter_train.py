@@ -1,0 +1,46 @@
+"""CI-sized training run: a few steps on a tiny dataset with the real model, torch and llama.cpp."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from agent.adapter.card import read_card
+from agent.adapter.data import generate
+from agent.adapter.evaluate import complete, load
+from agent.adapter.prompt import adapter_prompt
+from agent.adapter.train import Recipe, train
+from rsl.profile import Profile
+from tests.adapter.conftest import requires
+
+
+def test_a_few_steps_lower_the_loss_and_change_llama_cpp_output(profile: Profile, base_gguf: Path,
+                                                                 tmp_path: Path) -> None:
+    requires("torch", "transformers", "peft", "gguf")
+    pairs = generate(profile, 16, seed=5)
+    out = tmp_path / "tiny.gguf"
+    lines: list[str] = []
+    result = train(pairs, base_gguf, out, Recipe(steps=12, batch=4, learning_rate=1e-3, warmup=2, rank=4,
+                                                alpha=8, seed=1, threads=1), progress=lines.append)
+    assert result.steps == 12 and result.examples == 16
+    assert result.final_loss < 0.6 * result.first_loss, result.losses
+    assert any(line.startswith("step 12/12") and "loss" in line for line in lines)
+    assert out.stat().st_size > 0
+
+    prompt = adapter_prompt(pairs[0].normalized)
+    plain = complete(load(base_gguf, None, threads=1), prompt, max_tokens=12)
+    adapted = complete(load(base_gguf, out, threads=1), prompt, max_tokens=12)
+    assert adapted != plain
+
+
+def test_cli_refuses_bad_numbers_and_reads_a_card(tmp_path: Path) -> None:
+    from agent.adapter.card import AdapterCard
+    from agent.cli import main
+
+    assert main(["train-adapter", "--steps", "0"]) == 2
+    card = AdapterCard(adapter_file="a.gguf", adapter_sha256="0" * 64, base_model_file="b.gguf",
+                       base_model_sha256="1" * 64, profile_name="default", profile_sha256="2" * 64,
+                       prompt_version=1, data={"pairs": 3}, training={"steps": 1})
+    path = card.write(tmp_path / "a.json")
+    assert read_card(path) == card
+    assert json.loads(path.read_text())["licence"].startswith("The adapter is a derivative of Gemma")
