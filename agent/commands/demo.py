@@ -3,28 +3,26 @@
 from __future__ import annotations
 
 import argparse
-import sys
-from pathlib import Path
 from typing import Any
-
-EXAMPLE = Path(__file__).resolve().parents[2] / "docs" / "examples" / "fetch_cup.rsl"
 
 
 def register(subparsers: Any) -> None:
+    from agent.daemon.demo import DEFAULT_TASKS
+
     demo = subparsers.add_parser(
-        "demo", help="check and compile the example program",
-        description="Check and compile the example RSL program with the default robot profile.")
+        "demo", help="start the daemon on the simulator with the bundled model and carry out a task",
+        description="Start `nrtrans serve` on the simulator with the embedded model, wait until it is "
+                    "ready, submit each TASK over its socket as `nrtrans send` would, print the events "
+                    "up to the end of each task, then stop the daemon. Exit status 0 when every task "
+                    "was done.")
+    demo.add_argument("tasks", nargs="*", metavar="TASK", default=list(DEFAULT_TASKS),
+                      help=f"tasks in plain English (default: {DEFAULT_TASKS[0]!r})")
+    demo.add_argument("--realtime-factor", type=float, default=1.0, metavar="F",
+                      help="simulated seconds per wall second; 0 runs as fast as possible (default: 1)")
     demo.set_defaults(func=_demo)
 
 
 def _demo(args: argparse.Namespace) -> int:
-    from rsl.compiler import compile_program
-    from rsl.profile import load_profile
+    from agent.daemon.demo import run_demo
 
-    result = compile_program(EXAMPLE.read_text(), load_profile())
-    for diagnostic in result.diagnostics:
-        print(diagnostic.render(), file=sys.stderr)
-    if result.plan is None:
-        return 1
-    print(result.plan.to_rsl(), end="")
-    return 0
+    return run_demo(args.tasks, realtime_factor=args.realtime_factor)
