@@ -101,6 +101,7 @@ def main() -> None:
     args = parser.parse_args()
     profile = load_profile()
     baseline = rss_mb()
+    load = round(os.getloadavg()[0], 2)
     rates, programs, stops = [], [], []
     for run in range(1, args.repeat + 1):
         print(f"run {run}/{args.repeat}: physics rate, standard program, stopping", file=sys.stderr, flush=True)
@@ -114,6 +115,7 @@ def main() -> None:
     figures = {
         "benchmark": "sim",
         "machine": f"{platform.machine()}, {os.cpu_count()} cores, shared with other jobs",
+        "load_average_1min_at_start": load,
         "repeat": args.repeat,
         "physics_hz": PHYSICS_HZ,
         "standard_program_text": STANDARD,

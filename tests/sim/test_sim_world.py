@@ -99,3 +99,15 @@ def test_open_robot_gives_the_simulator_and_rejects_unknown_backends(profile: Pr
         open_robot("gazebo", profile)
     with pytest.raises(BackendError, match="takes no option"):
         open_robot("sim", profile, node_name="x")
+
+
+def test_resting_objects_wake_when_the_robot_pushes_them(profile: Profile) -> None:
+    robot = SimRobot(profile)
+    try:
+        robot.world.step(300)  # long enough for the objects to fall asleep
+        assert robot.turnleft(math.atan2(1.8, 1.5)).ok
+        assert robot.forward(2.8).ok
+        bx, by, _ = robot.world.objects()["ball"]
+        assert math.hypot(bx - 1.5, by - 1.8) > 0.5  # shoved ahead of the base, not driven through
+    finally:
+        robot.close()
