@@ -10,6 +10,7 @@ stopped and the step fails with a reason instead of hanging the daemon.
 
 from __future__ import annotations
 
+import logging
 import math
 import threading
 from collections.abc import Callable
@@ -18,6 +19,8 @@ from dataclasses import dataclass
 from agent.robot import CancelToken, Outcome, Pose, Robot, RobotState, Status
 from rsl.plan import Command, ObjectRef, Plan
 from rsl.profile import Profile
+
+log = logging.getLogger(__name__)
 
 # Seconds of wall time the watchdog grants beyond a step's own budget, so a
 # backend that enforces the budget itself reports its own, more precise reason.
@@ -129,8 +132,13 @@ def execute(plan: Plan, robot: Robot, profile: Profile, *, cancel: CancelToken |
     outcomes: list[Outcome] = []
 
     def emit(event: StepEvent) -> None:
-        if on_event is not None:
+        if on_event is None:
+            return
+        try:
             on_event(event)
+        except Exception:
+            # Progress reporting must never leave the robot between steps of a half-run plan.
+            log.exception("the step event handler failed on %s; the plan goes on", event)
 
     for index, command in enumerate(plan.commands, start=1):
         statement = command.to_rsl()

@@ -26,7 +26,7 @@ from agent.robot import Robot
 TRACE_EVERY = 4  # physics steps between trajectory points (30 Hz at 120 Hz physics)
 GIF_PERIOD = 0.2  # s of simulated time between animation frames
 GIF_SIZE = (320, 240)
-GIF_MAX_FRAMES = 600  # beyond this the animation keeps every other frame, so memory stays bounded
+GIF_MAX_FRAMES = 300  # beyond this the animation keeps every other frame, so memory stays bounded
 
 
 @dataclass(frozen=True)

@@ -193,3 +193,15 @@ def test_a_closed_simulator_refuses_steps(profile: Profile) -> None:
     robot.close()
     assert robot.forward(1.0) == Outcome.failed("the simulator is closed")
     robot.close()  # twice is harmless
+
+
+def test_a_failing_event_handler_does_not_stop_the_plan(robot: SimRobot, profile: Profile, caplog) -> None:
+    seen = []
+
+    def handler(event) -> None:
+        seen.append(event.index)
+        raise IndexError("bug in a progress display")
+
+    result = execute(plan_of("forward 0.2; turnleft 0.2;", profile), robot, profile, on_event=handler)
+    assert result.status is Status.DONE and seen == [1, 1, 2, 2]
+    assert "the step event handler failed" in caplog.text
