@@ -153,7 +153,8 @@ def execute(plan: Plan, robot: Robot, profile: Profile, *, cancel: CancelToken |
         emit(StepEvent(index, total, statement, outcome))
         if not outcome.ok:
             break
-    status = Status.DONE if len(outcomes) == total and all(o.ok for o in outcomes) else outcomes[-1].status
+    finished = len(outcomes) == total and all(o.ok for o in outcomes)
+    status = Status.DONE if finished else outcomes[-1].status
     return ExecutionResult(status=status, outcomes=tuple(outcomes), final_state=_state(robot))
 
 

@@ -13,11 +13,12 @@ from pathlib import Path
 from PIL import Image
 
 NRTRANS = [sys.executable, "-m", "agent.cli"]
+REPO = Path(__file__).resolve().parents[2]
 
 
 def run(args: list[str], cwd: Path, stdin: str | None = None, timeout: float = 120) -> subprocess.CompletedProcess:
     return subprocess.run([*NRTRANS, "run-program", *args], cwd=cwd, input=stdin, capture_output=True,
-                          text=True, timeout=timeout, env={**os.environ, "PYTHONPATH": str(Path.cwd())})
+                          text=True, timeout=timeout, env={**os.environ, "PYTHONPATH": str(REPO)})
 
 
 def write(tmp_path: Path, text: str, name: str = "task.rsl") -> Path:
@@ -102,7 +103,7 @@ def test_sigterm_cancels_the_run_and_stops_the_robot(tmp_path: Path) -> None:
     write(tmp_path, "forward 5;\nturnleft 1;\n")
     process = subprocess.Popen([*NRTRANS, "run-program", "task.rsl", "--json", "--realtime-factor", "1"],
                                cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                               env={**os.environ, "PYTHONPATH": str(Path.cwd())})
+                               env={**os.environ, "PYTHONPATH": str(REPO)})
     assert process.stderr is not None
     line = process.stderr.readline()
     while "[1/2] forward 5; ..." not in line:

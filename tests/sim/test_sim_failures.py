@@ -160,7 +160,7 @@ def test_the_executor_watchdog_stops_a_step_slower_than_its_budget(profile: Prof
         took = time.monotonic() - started
     assert result.status is Status.FAILED
     assert result.outcomes[0].reason.startswith(f"`forward 3;` timed out after {budget:.1f} s")
-    assert budget + 1.5 < took < budget + 3.0
+    assert budget + 1.5 < took < budget + 4.0  # the 2 s grace, then braking
 
 
 def test_a_skill_the_backend_lacks_fails_clearly(robot: SimRobot) -> None:
