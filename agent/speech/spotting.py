@@ -118,10 +118,10 @@ class WakeSpotter:
             self.audio_samples -= len(self.audio.popleft()) // 2
         if self.recognizer.accept(block):
             return self._judge(self.recognizer.result(True), heard_in_partial=False)
-        if self._mentions_wake_word(str(self.recognizer.partial().get("partial", ""))):
-            # Closing the utterance now gives the word times of the wake word.
-            return self._judge(self.recognizer.result(False), heard_in_partial=True)
-        return None
+        if not self._mentions_wake_word(str(self.recognizer.partial().get("partial", ""))):
+            return None
+        # Closing the utterance now gives the word times of the wake word.
+        return self._judge(self.recognizer.result(False), heard_in_partial=True)
 
     def _judge(self, result: dict[str, Any], heard_in_partial: bool) -> WakeHit | None:
         """A hit when the closed stretch of speech holds the wake word; the stretch is forgotten either way."""
@@ -182,7 +182,10 @@ def words_after(result: dict[str, Any], cut_s: float | None, wake_words: Sequenc
     """The transcript of `result` after time `cut_s`, without a leading wake word or noise markers."""
     words = result.get("result")
     if words and cut_s is not None:
-        kept = [str(w["word"]) for w in words if float(w.get("start", 0.0)) >= cut_s - TIME_SLACK_S]
+        # By the middle of each word: a task recogniser that hears the tail of
+        # the wake word as a short word places it before the cut.
+        kept = [str(w["word"]) for w in words
+                if (float(w.get("start", 0.0)) + float(w.get("end", 0.0))) / 2 >= cut_s - TIME_SLACK_S]
     elif words:
         kept = [str(w["word"]) for w in words]
     else:

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from agent.speech import SpeechConfig, SpeechUnavailable
-from tests.speech.helpers import KOREAN, next_transcript, running, wait_for
+from tests.speech.helpers import KOREAN, assert_heard, hear, running, wait_for
 from tests.speech.pulse import VirtualMic
 
 
@@ -46,7 +46,6 @@ def test_microphone_that_appears_later_is_picked_up(audio_tools, say, collector)
         with VirtualMic(rescan=False) as late:
             wait_for(lambda: speech.health()["state"] == "waiting_for_wake_word", 15,
                      "the speech input to find the new device")
-            late.play(say("로봇 원점 이동"))
-            assert next_transcript(collector).text == "원점 이동"
+            assert_heard(hear(collector, lambda: late.play(say("로봇 원점 이동"))).text, "원점 이동")
         wait_for(lambda: speech.health()["state"] == "no_device", 15, "the loss of the device")
         assert "device_lost" in collector.kinds() or "device_error" in collector.kinds()
