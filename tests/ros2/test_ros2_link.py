@@ -4,13 +4,10 @@
 from __future__ import annotations
 
 import dataclasses
-import json
-import os
 import subprocess
 import sys
 import threading
 import time
-from pathlib import Path
 
 import pytest
 
@@ -71,22 +68,3 @@ def test_sim_bridge_rejects_bad_input_with_exit_2(args: list[str], message: str)
     assert done.returncode == 2, done.stderr
     assert message in done.stderr
 
-
-def test_run_program_dry_runs_in_the_simulator_then_drives_the_ros2_robot(tmp_path: Path) -> None:
-    program = tmp_path / "task.rsl"
-    program.write_text("perceive;\napproach table;\ngrasp cup;\ngoto 0, 0;\n", encoding="utf-8")
-    bridge = Bridge(2.0)
-    try:
-        done = subprocess.run([sys.executable, "-m", "agent.cli", "run-program", str(program),
-                               "--backend", "ros2", "--dry-run", "--json"], cwd=REPO,
-                              env={**os.environ, **ROS_ENV}, capture_output=True, text=True, timeout=100)
-        assert done.returncode == 0, done.stderr
-        report = json.loads(done.stdout)
-        assert report["dry_run"]["status"] == "done"
-        assert report["status"] == "done"
-        assert [s["status"] for s in report["steps"]] == ["done"] * 4
-        final = report["final_state"]
-        assert final["holding"] == "cup"
-        assert abs(final["pose"]["x"]) < 0.05 and abs(final["pose"]["y"]) < 0.05
-    finally:
-        assert bridge.terminate() == 0

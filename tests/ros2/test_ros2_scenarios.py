@@ -1,10 +1,10 @@
-"""The shared robot programs, run through the ROS 2 backend against `nrtrans sim-bridge`
-over real DDS: the backend here, the simulated robot in another process."""
+"""The shared robot programs (tests/sim/scenarios.py, the same the pybullet backend
+runs), through the ROS 2 backend against `nrtrans sim-bridge` over real DDS: the
+backend here, the simulated robot in another process."""
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import pytest
 
@@ -13,30 +13,9 @@ from agent.robot import CancelToken, Outcome, RobotState
 from agent.ros2.backend import Ros2Robot
 from rsl.compiler import compile_program
 from rsl.profile import Profile
+from tests.sim.scenarios import SCENARIOS, Scenario, check_final_state
 
 REALTIME_FACTOR = 2.0
-
-
-@dataclass(frozen=True)
-class Scenario:
-    name: str
-    program: str
-    pose: tuple[float, float, float]  # x, y, heading the robot must end at
-    holding: str | None = None
-    seen: tuple[str, ...] = ()
-
-
-SCENARIOS = [
-    Scenario("square_left", "forward 1; turnleft 1.5708; forward 1; turnleft 1.5708; "
-                            "forward 1; turnleft 1.5708; forward 1; turnleft 1.5708;", (0.0, 0.0, 0.0)),
-    Scenario("square_right_backward", "backward 0.5; turnright 1.5708; forward 0.5; turnright 1.5708; "
-                                      "forward 0.5;", (-1.0, -0.5, math.pi)),
-    Scenario("approach_then_grasp", "perceive; approach table; grasp cup;", (2.1, 0.0, 0.0), holding="cup",
-             seen=("table", "cup", "bottle")),
-    Scenario("look_around", "lookdown 0.3; lookleft 1.5708; perceive; lookright 3.1416; perceive; "
-                            "lookleft 1.5708; lookup 0.3;", (0.0, 0.0, 0.0), seen=("ball", "book", "banana")),
-    Scenario("goto_and_back", "goto 1.5, -1; goto 0, 0;", (0.0, 0.0, None)),  # type: ignore[arg-type]
-]
 
 
 def run_program(robot: Ros2Robot, profile: Profile, program: str) -> tuple[RobotState, tuple[Outcome, ...]]:
@@ -54,16 +33,7 @@ def run_program(robot: Ros2Robot, profile: Profile, program: str) -> tuple[Robot
 @pytest.mark.parametrize("scenario", SCENARIOS, ids=lambda s: s.name)
 def test_scenario_ends_where_expected(scenario: Scenario, robot: Ros2Robot, profile: Profile) -> None:
     state, outcomes = run_program(robot, profile, scenario.program)
-    x, y, heading = scenario.pose
-    assert math.hypot(state.pose.x - x, state.pose.y - y) < 0.05, state.pose
-    if heading is not None:
-        off = abs(math.remainder(state.pose.heading - heading, 2 * math.pi))
-        assert off < math.radians(2.0), state.pose
-    assert state.holding == scenario.holding
-    assert abs(state.head_pan) < 0.03 and abs(state.head_tilt) < 0.03
-    seen = {name.strip() for o in outcomes if o.reason.startswith("saw ")
-            for name in o.reason.removeprefix("saw ").split(",")}
-    assert set(scenario.seen) <= seen, seen
+    assert check_final_state(scenario, state, outcomes) == []
 
 
 def test_each_straight_move_and_turn_is_within_2cm_and_1_degree(robot: Ros2Robot) -> None:
