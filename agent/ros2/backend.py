@@ -396,7 +396,14 @@ class Ros2Robot:
         self._require_listener(lambda: self._link.listeners("head"),
                                self.config.head_trajectory)
         self._link.send_head(pan, tilt, duration)
-        self._await_joints({pan_joint: pan, tilt_joint: tilt}, duration, token, "head")
+        try:
+            self._await_joints({pan_joint: pan, tilt_joint: tilt}, duration, token, "head")
+        except _Cancelled:
+            # Hold the head where it is rather than letting it finish the cancelled move.
+            now, _ = self._link.joints()
+            with self._publish_lock:
+                self._link.send_head(now[pan_joint], now[tilt_joint], 0.0)
+            raise
         return Outcome.done("; ".join(notes))
 
     def _move_gripper(self, position: float, token: CancelToken) -> None:

@@ -198,3 +198,17 @@ def test_a_profile_skill_the_backend_lacks_fails_as_a_step(bridge: Bridge, probe
         assert not hasattr(robot, "dance")
     assert outcome.status is Status.FAILED
     assert "no implementation of the skill `wave`" in outcome.reason
+
+
+def test_cancelling_a_head_move_holds_the_head_where_it_is(robot: Ros2Robot) -> None:
+    token = CancelToken()
+    thread, result = start_in_background(lambda: robot.lookleft(1.5, cancel=token))
+    time.sleep(0.4)
+    token.set("operator said stop")
+    thread.join(5.0)
+    assert result == [Outcome.cancelled("operator said stop")]
+    time.sleep(0.3)
+    held = robot.state().head_pan
+    time.sleep(1.0)
+    assert 0.1 < held < 1.4, held
+    assert abs(robot.state().head_pan - held) < 0.02, "the head went on moving after the cancel"
