@@ -304,7 +304,7 @@ class Service:
                     self._current = None
             if self.speech is not None:
                 # `perceive` may have found objects; let speech recognition expect their names.
-                _quietly(lambda: self.speech.set_objects(self._known_objects()))
+                _quietly(lambda: self.speech.set_objects(self._known_objects() or []))
             self.on_status(
                 self.idle_status()
                 if self._estop_reason is None
@@ -341,7 +341,7 @@ class Service:
         self.audit.write(task.record())
         self._execute(task, plan, start)
 
-    def _translate(self, task: Task, known: list[str], start: float) -> Any:
+    def _translate(self, task: Task, known: list[str] | None, start: float) -> Any:
         assert task.text is not None
         task.state = TaskState.TRANSLATING
         self.audit.write(task.record())
@@ -376,7 +376,7 @@ class Service:
             return None
         return result.plan
 
-    def _compile(self, task: Task, known: list[str], start: float) -> Any:
+    def _compile(self, task: Task, known: list[str] | None, start: float) -> Any:
         from rsl.compiler import compile_program
 
         assert task.rsl is not None
@@ -474,12 +474,19 @@ class Service:
                 break
             self._tasks.popitem(last=False)
 
-    def _known_objects(self) -> list[str]:
+    def _known_objects(self) -> list[str] | None:
+        """The objects programs may name; None leaves names to the robot to check.
+
+        Until the robot has perceived anything, every name is left open:
+        rejecting "grasp the cup" before the robot has looked would refuse
+        tasks it can carry out, since backends look for an object on demand.
+        """
         try:
-            return [name for name, _x, _y in self.robot.state().known_objects]
+            known = [name for name, _x, _y in self.robot.state().known_objects]
         except Exception as exc:
             log.warning("cannot read the known objects from the robot: %s", exc)
-            return []
+            return None
+        return known or None
 
     def _stop_robot(self) -> None:
         if self.robot is None:

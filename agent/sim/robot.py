@@ -243,9 +243,13 @@ class SimRobot:
             raise _Refused(f"unknown object `{name}`: there is no {name} in the scene `{scene.name}`; "
                            f"objects there: {', '.join(scene.names) or 'none'}")
         if name not in self._known:
+            # Look before refusing: a person who says "grasp the cup" expects
+            # the robot to use its eyes, as long as the cup is really in view.
+            self._known.update(self.world.visible_objects())
+        if name not in self._known:
             known = ", ".join(sorted(self._known)) or "none yet"
-            raise _Refused(f"unknown object `{name}`: the robot has not seen it (known objects: {known}); "
-                           "`perceive;` while facing it first")
+            raise _Refused(f"unknown object `{name}`: the robot has not seen it and cannot see it from here "
+                           f"(known objects: {known}); turn towards it or look around first")
         x, y, _z = self.world.objects()[name]
         return x, y
 

@@ -39,13 +39,13 @@ def test_an_object_not_in_the_scene_fails_with_the_names_there(robot: SimRobot) 
     assert robot.state().pose.x == pytest.approx(0.0, abs=1e-6)
 
 
-def test_an_object_not_yet_seen_must_be_perceived_first(robot: SimRobot) -> None:
-    outcome = robot.grasp("book")
+def test_an_object_out_of_view_is_refused_and_one_in_view_is_looked_for(robot: SimRobot) -> None:
+    outcome = robot.grasp("book")  # behind the robot
     assert outcome.status is Status.FAILED
-    assert "has not seen it" in outcome.reason and "`perceive;`" in outcome.reason
-    assert robot.perceive().ok
-    outcome = robot.approach("book")  # behind the robot: still not in view
-    assert "has not seen it" in outcome.reason and "known objects: bottle, cup, table" in outcome.reason
+    assert "cannot see it from here" in outcome.reason and "look around first" in outcome.reason
+    assert "known objects: bottle, cup, table" in outcome.reason
+    assert robot.state().pose.x == pytest.approx(0.0, abs=1e-6)
+    assert robot.approach("table").ok  # in view, though never perceived by name
 
 
 def test_grasp_out_of_reach_says_how_far(robot: SimRobot) -> None:
