@@ -29,8 +29,7 @@ class SpeechConfig:
     # Said before a task; an empty list means push-to-talk only.
     wake_words: tuple[str, ...] = ("robot",)
     # Quiet after speech that ends the utterance. It is most of the delay
-    # from end of speech to transcript (see docs/speech.md): 500 ms measured
-    # 0.63 s median, 800 ms 0.92 s.
+    # from end of speech to transcript (see docs/speech.md).
     silence_ms: int = 500
     max_utterance_s: float = 15.0
     # After push-to-talk or a lone wake word: how long to wait for speech.
