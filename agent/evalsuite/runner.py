@@ -30,10 +30,16 @@ def run_suite(translator: Any, tasks: Sequence[EvalTask], profile: Profile,
               progress: Callable[[int, int, TaskOutcome], None] | None = None) -> list[TaskOutcome]:
     outcomes = []
     for index, task in enumerate(tasks, start=1):
-        result = translator.translate(task.task, known_objects=task.objects)
-        outcome = TaskOutcome(task=task, program=result.program, verified=result.verified,
-                              accepted=accepts(task, result.plan, profile), passes=result.passes,
-                              latency_ms=result.timings_ms.get("total", 0.0))
+        try:
+            result = translator.translate(task.task, known_objects=task.objects)
+        except ValueError as exc:
+            # A task the translator refuses (too long for the context) is a failed task, not a crashed run.
+            outcome = TaskOutcome(task=task, program=f"<error: {exc}>", verified=False, accepted=False,
+                                  passes=0, latency_ms=0.0)
+        else:
+            outcome = TaskOutcome(task=task, program=result.program, verified=result.verified,
+                                  accepted=accepts(task, result.plan, profile), passes=result.passes,
+                                  latency_ms=result.timings_ms.get("total", 0.0))
         outcomes.append(outcome)
         if progress is not None:
             progress(index, len(tasks), outcome)

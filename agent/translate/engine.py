@@ -159,7 +159,7 @@ class TokenMasks:
 class LocalEngine:
     """A loaded model; `generate` continues a prompt greedily, reusing the KV cache of a shared prefix."""
 
-    def __init__(self, path: Path, *, lora_path: Path | None = None, n_ctx: int = 2048) -> None:
+    def __init__(self, path: Path, *, lora_path: Path | None = None, n_ctx: int = 4096) -> None:
         self.path = path
         self.llm = open_llama(path, n_ctx=n_ctx, lora_path=lora_path)
         self.vocabulary = Vocabulary(self.llm)
