@@ -104,7 +104,7 @@ class Ros2Robot:
 
     def approach(self, name: str, *, cancel: CancelToken | None = None) -> Outcome:
         def run(token: CancelToken) -> Outcome:
-            ox, oy = self._object_position(name)
+            ox, oy = self._object_position(name, token)
             here = self._fresh_odometry().pose
             away = math.hypot(ox - here.x, oy - here.y)
             heading = math.atan2(oy - here.y, ox - here.x) if away > 1e-3 else here.heading
@@ -155,7 +155,7 @@ class Ros2Robot:
             if self._holding_now() is not None:
                 raise StepFailure(f"cannot grasp {name}: already holding {self._holding_now()}; "
                                   "the gripper holds one object at a time")
-            ox, oy = self._object_position(name)
+            ox, oy = self._object_position(name, token)
             here = self._fresh_odometry().pose
             away = math.hypot(ox - here.x, oy - here.y)
             reach = self.profile.motion.reach
@@ -476,7 +476,24 @@ class Ros2Robot:
                                   "Is its controller running and is the topic name in the profile right?")
             time.sleep(0.05)
 
-    def _object_position(self, name: str) -> tuple[float, float]:
+    def _object_position(self, name: str, token: CancelToken) -> tuple[float, float]:
+        found, error = self._lookup_object(name)
+        if found is not None:
+            return found
+        if error:
+            return self._unknown_object(name)
+        # Look before refusing, as the simulator does: a person who says "grasp
+        # the cup" expects the robot to use its camera if the cup is in view.
+        reply = self._link.call_perceive(token)
+        if reply.success:
+            report = decode_objects(reply.message, f"reply of {self.config.perceive_service}")
+            self._known.update(report.objects)
+            self._footprints.update(report.footprints)
+            if name in self._known:
+                return self._known[name]
+        return self._unknown_object(name)
+
+    def _lookup_object(self, name: str) -> tuple[tuple[float, float] | None, str | None]:
         report, error = self._link.objects()
         deadline = time.monotonic() + FIRST_MESSAGE_WAIT
         while report is None and not error and name not in self._known and time.monotonic() < deadline:
@@ -484,13 +501,16 @@ class Ros2Robot:
             time.sleep(0.05)
             report, error = self._link.objects()
         if report is not None and name in report.objects:
-            return report.objects[name]
-        if name in self._known:
-            return self._known[name]
+            return report.objects[name], None
+        return self._known.get(name), error
+
+    def _unknown_object(self, name: str) -> tuple[float, float]:
+        report, error = self._link.objects()
         known = sorted(set(self._known) | set(report.objects if report else ()))
         hint = f"known objects: {', '.join(known)}" if known else "no objects are known yet"
         extra = f" (the objects topic sent malformed data: {error})" if error else ""
-        raise StepFailure(f"unknown object `{name}`: {hint}{extra}; `perceive;` while facing it first")
+        raise StepFailure(f"unknown object `{name}`: the robot has not seen it and cannot see it from here "
+                          f"({hint}{extra}); turn towards it or look around first")
 
     def _edge(self, name: str, direction: float) -> float:
         """How far the object's edge is from its centre, seen from `direction`; 0 if unknown."""

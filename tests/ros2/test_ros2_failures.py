@@ -57,8 +57,9 @@ def assert_stopped_after(probe: Probe, since: float, within: float) -> None:
 
 
 def test_unknown_object_fails_with_the_known_ones_and_does_not_move(robot: Ros2Robot, probe: Probe) -> None:
-    assert robot.approach("table").reason.startswith("unknown object `table`: no objects are known yet")
-    assert robot.perceive().ok
+    outcome = robot.approach("book")  # behind the robot: looking for it finds only what is in front
+    assert outcome.reason.startswith("unknown object `book`: the robot has not seen it and cannot see it")
+    assert "known objects: bottle, cup, table" in outcome.reason
     outcome = robot.approach("unicorn")
     assert outcome.status is Status.FAILED
     assert "unknown object `unicorn`" in outcome.reason and "table" in outcome.reason
@@ -149,11 +150,10 @@ def test_malformed_object_reports_fail_with_a_clear_reason(bridge: Bridge, probe
     garbled = probe.publisher(String, config.objects_topic)
     with Ros2Robot(profile, config=config, connect_timeout=30.0) as robot:
         deadline = time.monotonic() + 5.0
-        outcome = robot.approach("cup")
-        while "malformed" not in outcome.reason and time.monotonic() < deadline:
+        while not robot._link.objects()[1] and time.monotonic() < deadline:
             garbled.publish(String(data="{not json"))
             time.sleep(0.1)
-            outcome = robot.approach("cup")
+        outcome = robot.approach("cup")
     assert outcome.status is Status.FAILED
     assert "unknown object `cup`" in outcome.reason
     assert "malformed" in outcome.reason and "not the documented JSON" in outcome.reason
