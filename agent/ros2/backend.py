@@ -400,9 +400,9 @@ class Ros2Robot:
             self._await_joints({pan_joint: pan, tilt_joint: tilt}, duration, token, "head")
         except _Cancelled:
             # Hold the head where it is rather than letting it finish the cancelled move.
-            now, _ = self._link.joints()
+            positions, _ = self._link.joints()
             with self._publish_lock:
-                self._link.send_head(now[pan_joint], now[tilt_joint], 0.0)
+                self._link.send_head(positions[pan_joint], positions[tilt_joint], 0.0)
             raise
         return Outcome.done("; ".join(notes))
 
