@@ -104,3 +104,18 @@ def test_missing_model_gives_a_clear_error(profile: Profile, tmp_path) -> None:
         Translator.load(profile, model=str(tmp_path / "missing.gguf"))
     with pytest.raises(ModelNotFoundError, match="adapter"):
         Translator.load(profile, adapter=str(tmp_path / "missing-adapter.gguf"))
+
+
+def test_adapter_mode_uses_the_lora_and_stays_verified(profile: Profile) -> None:
+    from agent.adapter.prompt import DEFAULT_ADAPTER
+
+    if not DEFAULT_ADAPTER.is_file():
+        pytest.skip("no shipped adapter in models/adapters/")
+    adapted = Translator.load(profile, adapter="default")
+    try:
+        assert adapted.options.adapter_prompt and adapted.options.shots == 0
+        assert adapted.model_name.endswith("+" + DEFAULT_ADAPTER.name)
+        result = adapted.translate("pick up the cup", known_objects=["cup"])
+        assert result.verified and result.program == "grasp cup;\n"
+    finally:
+        adapted.close()
