@@ -23,7 +23,9 @@ def test_a_few_steps_lower_the_loss_and_change_llama_cpp_output(profile: Profile
     result = train(pairs, base_gguf, out, Recipe(steps=12, batch=4, learning_rate=1e-3, warmup=2, rank=4,
                                                 alpha=8, seed=1, threads=1), progress=lines.append)
     assert result.steps == 12 and result.examples == 16
-    assert result.final_loss < 0.6 * result.first_loss, result.losses
+    # 16 pairs in batches of 4: steps 1-4 and 9-12 see the same pairs, before and after learning them.
+    first_epoch, last_epoch = result.losses[:4], result.losses[-4:]
+    assert sum(last_epoch) < 0.6 * sum(first_epoch), result.losses
     assert any(line.startswith("step 12/12") and "loss" in line for line in lines)
     assert out.stat().st_size > 0
 

@@ -1,0 +1,41 @@
+"""The shipped adapter: its card matches, and llama.cpp with it writes RSL for unseen commands."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from agent.adapter.card import card_path, read_card, sha256_of
+from agent.adapter.evaluate import complete, load
+from agent.adapter.prompt import DEFAULT_ADAPTER, PROMPT_VERSION, adapter_prompt
+from agent.normalize import normalize_task
+from rsl.profile import Profile
+
+# Written for this test; none is in the training data or the eval suite.
+COMMANDS = {
+    "Drive forward 3.7 meters": "forward 3.7;\n",
+    "rotate right 35 degrees then pick up the stapler": "turnright 0.6109;\ngrasp stapler;\n",
+    "uh back up 40 centimeters": "backward 0.4;\n",
+}
+
+
+def test_the_card_describes_the_shipped_adapter(base_gguf: Path, profile: Profile) -> None:
+    card = read_card(card_path(DEFAULT_ADAPTER))
+    assert card.adapter_sha256 == sha256_of(DEFAULT_ADAPTER)
+    assert card.base_model_sha256 == sha256_of(base_gguf)
+    assert card.prompt_version == PROMPT_VERSION
+    assert card.profile_name == profile.name
+    assert card.training["final_loss"] < card.training["first_loss"]
+    assert "Gemma Terms of Use" in card.licence
+
+
+@pytest.fixture(scope="module")
+def adapted(base_gguf: Path):
+    return load(base_gguf, DEFAULT_ADAPTER, threads=1)
+
+
+@pytest.mark.parametrize("task", sorted(COMMANDS))
+def test_the_adapter_writes_the_program(adapted, task: str) -> None:
+    got = complete(adapted, adapter_prompt(normalize_task(task)), max_tokens=40)
+    assert got.strip() + "\n" == COMMANDS[task]
