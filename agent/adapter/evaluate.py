@@ -86,7 +86,8 @@ def evaluate(llm: Any, pairs: Sequence[Pair], profile: Profile, *, grammar: bool
     failures = []
     for index, pair in enumerate(pairs):
         started = time.perf_counter()
-        text = complete(llm, adapter_prompt(pair.normalized), gbnf)
+        # A program has fewer tokens than characters; a runaway answer is cut there, not at MAX_TOKENS.
+        text = complete(llm, adapter_prompt(pair.normalized), gbnf, max_tokens=len(pair.program) + 16)
         latencies.append((time.perf_counter() - started) * 1000)
         got = text.strip() + "\n"
         want = compile_program(pair.program, profile).plan

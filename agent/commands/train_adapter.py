@@ -39,8 +39,8 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--threads", type=int, default=1, metavar="N",
                         help="CPU threads for training (default 1: on a CPU shared with other work, one "
                              "thread is several times faster than two that wait for each other)")
-    parser.add_argument("--eval", type=int, default=150, metavar="N", dest="eval_pairs",
-                        help="held-out synthetic pairs to score the adapter on with llama.cpp (default 150; "
+    parser.add_argument("--eval", type=int, default=60, metavar="N", dest="eval_pairs",
+                        help="held-out synthetic pairs to score the adapter on with llama.cpp (default 60; "
                              "0 skips)")
     parser.add_argument("--dump-data", metavar="FILE", help="also write the training pairs here as JSON lines")
     parser.set_defaults(func=_train)
