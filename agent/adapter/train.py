@@ -116,7 +116,7 @@ def batches(examples: list[tuple[list[int], list[int]]], batch: int, steps: int,
         order = examples[:]
         rng.shuffle(order)
         chunk = batch * 16
-        epoch = []
+        epoch: list[list[tuple[list[int], list[int]]]] = []
         for start in range(0, len(order), chunk):
             group = sorted(order[start:start + chunk], key=lambda e: len(e[0]))
             epoch.extend(group[i:i + batch] for i in range(0, len(group), batch))
@@ -144,7 +144,7 @@ def train(pairs: Sequence[Pair], base_gguf: Path, out: Path, recipe: Recipe, *,
     tokenizer, model = load_base(base_gguf)
     if recipe.bf16:
         model = model.to(torch.bfloat16)
-    config = LoraConfig(r=recipe.rank, lora_alpha=recipe.alpha, lora_dropout=0.0,
+    config = LoraConfig(r=recipe.rank, lora_alpha=int(recipe.alpha), lora_dropout=0.0,
                         target_modules=list(TARGET_MODULES), bias="none", task_type="CAUSAL_LM")
     model = get_peft_model(model, config).to(device)
     model.train()

@@ -109,9 +109,12 @@ def _train(args: argparse.Namespace) -> int:
         print(f"scoring the adapter on {len(held_out)} held-out synthetic pairs with llama.cpp ...",
               file=sys.stderr)
         llm = load(base, out, threads=args.threads or None)
-        score = evaluate(llm, held_out, profile,
-                         progress=lambda done, total: done % 25 == 0 and print(
-                             f"  {done}/{total}", file=sys.stderr, flush=True))
+
+        def report(done: int, total: int) -> None:
+            if done % 10 == 0 or done == total:
+                print(f"  {done}/{total}", file=sys.stderr, flush=True)
+
+        score = evaluate(llm, held_out, profile, progress=report)
         scores = {"synthetic_held_out": score.to_dict()}
         for task, want, got in score.failures[:5]:
             print(f"  miss: {task!r}\n    want {want.strip()!r}\n    got  {got.strip()!r}", file=sys.stderr)
