@@ -23,10 +23,11 @@ def add_model_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-grammar", action="store_true",
                         help="sample without the RSL grammar (the unconstrained setting, for comparison)")
     parser.add_argument("--shots", type=int, default=None, metavar="N",
-                        help="worked examples in the prompt (default: 4 without an adapter, 0 with one)")
-    parser.add_argument("--shots-in-prefix", action="store_true",
-                        help="put every worked example in the fixed, cached prompt prefix (fast: a request "
-                             "only evaluates its task), with --shots N similar ones after it")
+                        help="worked examples picked by similarity to each clause, after the fixed prompt "
+                             "(default: 0; every example is already in the fixed prefix)")
+    parser.add_argument("--no-prefix-shots", action="store_true",
+                        help="leave the worked examples out of the fixed, KV-cached prompt prefix "
+                             "(then use --shots N to pick similar ones per clause)")
     parser.add_argument("--no-split", action="store_true",
                         help="translate the task in one go instead of clause by clause")
     parser.add_argument("--no-narrow", action="store_true",
@@ -47,7 +48,7 @@ def load_translator(args: argparse.Namespace) -> Any:
     return Translator.load(profile, model=args.model, adapter=args.adapter, grammar=not args.no_grammar,
                            max_passes=args.max_passes, endpoint=args.endpoint, shots=args.shots,
                            split_clauses=not args.no_split, narrow=not args.no_narrow,
-                           prefix_shots=args.shots_in_prefix)
+                           prefix_shots=not args.no_prefix_shots)
 
 
 def register(subparsers: Any) -> None:

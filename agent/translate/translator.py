@@ -39,7 +39,7 @@ from rsl.profile import Convention, Profile
 MAX_TOKENS = 160
 # One clause rarely needs more; a square is 8 statements.
 CLAUSE_STATEMENTS = 8
-DEFAULT_SHOTS = 4
+DEFAULT_SHOTS = 0
 _NUMBER = re.compile(r"-?\d*\.?\d+")
 _NUMBER_UNIT = re.compile(r"(-?\d*\.?\d+)(?: (m|rad)\b)?")
 _OBJECT_PHRASE = re.compile(r"\b(?:the|a|an|some|that|this|my|your) ((?:[a-z]+ )?[a-z]+)\b")
@@ -69,7 +69,7 @@ class Options:
     shots: int = DEFAULT_SHOTS
     # The whole shot bank inside the fixed, KV-cached prefix, so a request
     # evaluates only its own task; `shots` similar ones may still follow.
-    prefix_shots: bool = False
+    prefix_shots: bool = True
     split_clauses: bool = True
     narrow: bool = True
     adapter_prompt: bool = False
@@ -107,7 +107,7 @@ class Translator:
     @classmethod
     def load(cls, profile: Profile, *, model: str | None = None, adapter: str | None = None,
              grammar: bool = True, max_passes: int = 3, endpoint: str | None = None, shots: int | None = None,
-             split_clauses: bool = True, narrow: bool = True, prefix_shots: bool = False) -> Translator:
+             split_clauses: bool = True, narrow: bool = True, prefix_shots: bool = True) -> Translator:
         """Load the model (or connect to `endpoint`).
 
         `adapter`: None or "none" for no adapter, "default" for the shipped

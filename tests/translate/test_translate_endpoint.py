@@ -42,7 +42,7 @@ def server(model_path: Path, tmp_path_factory: pytest.TempPathFactory) -> Iterat
     log = tmp_path_factory.mktemp("llm-server") / "server.log"
     process = subprocess.Popen(
         [sys.executable, "-c", SERVE, "--model", str(model_path), "--host", "127.0.0.1", "--port", str(port),
-         "--n_ctx", "2048", "--n_threads", os.environ.get("NRTRANS_THREADS", "2")],
+         "--n_ctx", "4096", "--n_threads", os.environ.get("NRTRANS_THREADS", "2")],
         stdout=subprocess.DEVNULL, stderr=log.open("w"))
     url = f"http://127.0.0.1:{port}"
     try:
