@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import platform
 import statistics
 import sys
@@ -71,7 +72,7 @@ def main() -> int:
     medians = {k: statistics.median(v) for k, v in rates.items() if v}
     report = {
         "model": translator.model_name,
-        "machine": f"{platform.machine()}, shared with other jobs while measured",
+        "machine": f"{platform.machine()}, {os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f} at the end",
         "tokens_per_prompt": TOKENS,
         "samples": {k: len(v) for k, v in rates.items()},
         "median_tokens_per_s": {k: round(v, 2) for k, v in medians.items()},

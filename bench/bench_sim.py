@@ -114,7 +114,7 @@ def main() -> None:
 
     figures = {
         "benchmark": "sim",
-        "machine": f"{platform.machine()}, {os.cpu_count()} cores, shared with other jobs",
+        "machine": f"{platform.machine()}, {os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f} at the end",
         "load_average_1min_at_start": load,
         "repeat": args.repeat,
         "physics_hz": PHYSICS_HZ,

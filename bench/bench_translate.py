@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import platform
 import statistics
 import sys
@@ -59,7 +60,7 @@ def main() -> int:
     report = {
         "model": translator.model_name,
         "options": vars(translator.options),
-        "machine": f"{platform.machine()}, 2 cores shared with other jobs while measured",
+        "machine": f"{platform.machine()}, {os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f} at the end",
         "tasks": len(tasks),
         "verified": verified,
         "mean_passes": statistics.fmean(passes),
