@@ -4,8 +4,6 @@ backend here, the simulated robot in another process."""
 
 from __future__ import annotations
 
-import math
-
 import pytest
 
 from agent.executor import execute
@@ -13,7 +11,7 @@ from agent.robot import CancelToken, Outcome, RobotState
 from agent.ros2.backend import Ros2Robot
 from rsl.compiler import compile_program
 from rsl.profile import Profile
-from tests.sim.scenarios import SCENARIOS, Scenario, check_final_state
+from tests.sim.scenarios import SCENARIOS, Scenario, check_final_state, check_moves_and_turns
 
 REALTIME_FACTOR = 2.0
 
@@ -37,16 +35,7 @@ def test_scenario_ends_where_expected(scenario: Scenario, robot: Ros2Robot, prof
 
 
 def test_each_straight_move_and_turn_is_within_2cm_and_1_degree(robot: Ros2Robot) -> None:
-    start = robot.state().pose
-    assert robot.forward(0.73).ok
-    moved = robot.state().pose
-    assert abs(math.hypot(moved.x - start.x, moved.y - start.y) - 0.73) < 0.02
-    assert robot.turnright(2.5).ok
-    turned = robot.state().pose
-    assert abs(math.remainder(turned.heading - (moved.heading - 2.5), 2 * math.pi)) < math.radians(1.0)
-    assert robot.turnleft(6.2832 + 0.5).ok  # more than a full circle must count the full circle
-    again = robot.state().pose
-    assert abs(math.remainder(again.heading - (turned.heading + 0.5), 2 * math.pi)) < math.radians(1.0)
+    check_moves_and_turns(robot)
 
 
 def test_the_head_stops_at_its_joint_limits(robot: Ros2Robot, profile: Profile) -> None:

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from agent.robot import Outcome, RobotState
+from agent.robot import Outcome, Robot, RobotState
 
 POSITION_TOLERANCE = 0.05  # m
 HEADING_TOLERANCE = math.radians(2.0)
@@ -72,3 +72,21 @@ def check_final_state(scenario: Scenario, state: RobotState,
     if missing:
         problems.append(f"perceive never reported {', '.join(sorted(missing))}")
     return problems
+
+
+def check_moves_and_turns(robot: Robot) -> None:
+    """Straight moves and turns end within 2 cm and 1 degree, on any backend."""
+    start = robot.state().pose
+    assert robot.forward(0.73).ok
+    moved = robot.state().pose
+    assert abs(math.hypot(moved.x - start.x, moved.y - start.y) - 0.73) < 0.02
+    assert robot.turnright(2.5).ok
+    turned = robot.state().pose
+    assert abs(math.remainder(turned.heading - (moved.heading - 2.5), 2 * math.pi)) < math.radians(1.0)
+    assert robot.turnleft(6.2832 + 0.5).ok  # more than a full circle counts it
+    again = robot.state().pose
+    assert abs(math.remainder(again.heading - (turned.heading + 0.5), 2 * math.pi)) < math.radians(1.0)
+    assert robot.backward(1.2).ok
+    back = robot.state().pose
+    assert abs(math.hypot(back.x - again.x, back.y - again.y) - 1.2) < 0.02
+    assert abs(math.remainder(back.heading - again.heading, 2 * math.pi)) < math.radians(1.0)

@@ -12,7 +12,7 @@ from agent.robot import Status
 from agent.sim.robot import SimRobot
 from rsl.compiler import compile_program
 from rsl.profile import Profile
-from tests.sim.scenarios import SCENARIOS, Scenario, check_final_state
+from tests.sim.scenarios import SCENARIOS, Scenario, check_final_state, check_moves_and_turns
 
 
 def plan_of(program: str, profile: Profile):
@@ -37,20 +37,7 @@ def test_scenario_ends_where_expected(scenario: Scenario, robot: SimRobot, profi
 
 
 def test_straight_moves_and_turns_within_2cm_and_1_degree(robot: SimRobot) -> None:
-    start = robot.state().pose
-    assert robot.forward(0.73).ok
-    moved = robot.state().pose
-    assert abs(math.hypot(moved.x - start.x, moved.y - start.y) - 0.73) < 0.02
-    assert robot.turnright(2.5).ok
-    turned = robot.state().pose
-    assert abs(math.remainder(turned.heading - (moved.heading - 2.5), 2 * math.pi)) < math.radians(1.0)
-    assert robot.turnleft(6.2832 + 0.5).ok  # more than a full circle must count the full circle
-    again = robot.state().pose
-    assert abs(math.remainder(again.heading - (turned.heading + 0.5), 2 * math.pi)) < math.radians(1.0)
-    assert robot.backward(1.2).ok
-    back = robot.state().pose
-    assert abs(math.hypot(back.x - again.x, back.y - again.y) - 1.2) < 0.02
-    assert abs(math.remainder(back.heading - again.heading, 2 * math.pi)) < math.radians(1.0)
+    check_moves_and_turns(robot)
 
 
 def test_motions_respect_the_profile_speed_and_acceleration(robot: SimRobot, profile: Profile) -> None:
