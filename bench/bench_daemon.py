@@ -151,16 +151,22 @@ def bench_tasks(daemon: Daemon, count: int) -> tuple[list[float], list[dict[str,
     return firsts, records
 
 
+def _start_moving(client: Client, settle: float) -> str:
+    """Submit a long drive and return its id once the robot has been moving for `settle` seconds."""
+    task = client.submit(rsl="forward 3;", follow=True)
+    for event in client.events():
+        if event["event"] == "executing" and event["task"] == task:
+            break
+    time.sleep(settle)
+    return task
+
+
 def bench_estop(daemon: Daemon, count: int) -> list[float]:
     """Client-side time from sending `estop` to its reply; the daemon replies after robot.stop() returns."""
     times = []
     with Client.connect(daemon.socket, timeout=60) as client, Client.connect(daemon.socket, timeout=60) as operator:
         for _ in range(count):
-            task = client.submit(rsl="forward 3;", follow=True)
-            for event in client.events():
-                if event["event"] == "executing" and event["task"] == task:
-                    break
-            time.sleep(0.3)
+            task = _start_moving(client, settle=0.3)
             sent = time.perf_counter()
             operator.estop("benchmark")
             times.append((time.perf_counter() - sent) * 1000)
@@ -213,11 +219,7 @@ def bench_estop_ros2(workdir: Path, count: int) -> list[float]:
         daemon.start()
         with Client.connect(daemon.socket, timeout=60) as client, Client.connect(daemon.socket, timeout=60) as operator:
             for _ in range(count):
-                task = client.submit(rsl="forward 3;", follow=True)
-                for event in client.events():
-                    if event["event"] == "executing" and event["task"] == task:
-                        break
-                time.sleep(0.5)
+                task = _start_moving(client, settle=0.5)
                 sent = time.perf_counter()
                 operator.estop("benchmark")
                 deadline = time.monotonic() + 2.0
