@@ -18,6 +18,7 @@ from typing import Any, Literal
 
 IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 SKILL_KEYWORD = re.compile(r"[a-z][a-z0-9_]*\Z")
+_AMOUNT = re.compile(r"\d\s*[a-z]+\b")
 
 ParamKind = Literal["number", "object"]
 
@@ -66,6 +67,17 @@ class Convention:
     meaning: str
     task: str
     program: str
+
+    @property
+    def whole_command(self) -> bool:
+        """Whether the phrase is a whole command ("look around") rather than an amount ("a little").
+
+        An amount's meaning gives numbers with units and its example task says
+        more than the phrase; a whole command is run as its program.
+        """
+        if not self.program:
+            return False
+        return self.task.strip() == self.phrase or not _AMOUNT.search(self.meaning)
 
 
 @dataclass(frozen=True)

@@ -20,6 +20,7 @@ import re
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
+from agent.adapter.prompt import adapter_prompt
 from agent.normalize import normalize_task
 from rsl.plan import Command, ObjectRef, Plan, Quantity, format_number
 from rsl.profile import Convention, Profile, Skill
@@ -40,6 +41,7 @@ class Pair:
     normalized: str
     program: str
     group: str
+    prompt: str  # what the model is given: `adapter_prompt` of the normalized task
 
 
 @dataclass(frozen=True)
@@ -128,8 +130,7 @@ PERCEIVE = ("perceive", "look for objects", "scan the area", "scan the room", "d
             "take a look", "see what is around", "observe the scene", "check what is in front of you",
             "scan your surroundings", "detect what is there", "take a picture")
 SEARCH = ("find the {o}", "look for the {o}", "search for the {o}", "locate the {o}", "spot the {o}",
-          "try to find the {o}", "search the area for the {o}", "scan for the {o}", "look around for the {o}",
-          "detect the {o}")
+          "try to find the {o}", "search the area for the {o}", "scan for the {o}", "detect the {o}")
 APPROACH = ("approach the {o}", "go to the {o}", "move to the {o}", "drive up to the {o}", "go over to the {o}",
             "come to the {o}", "navigate to the {o}", "get close to the {o}", "head to the {o}",
             "drive to the {o}", "move towards the {o}", "go near the {o}", "walk up to the {o}")
@@ -239,15 +240,8 @@ def convention_amounts(conventions: Sequence[Convention]) -> tuple[list[Amount],
 
 def program_conventions(conventions: Sequence[Convention], profile: Profile) -> list[Convention]:
     """Conventions that are whole commands ("turn around", "look around")."""
-    out = []
-    for convention in conventions:
-        if not convention.program or not convention.task:
-            continue
-        whole = convention.task.strip() == convention.phrase or not re.search(
-            r"\d\s*(m|rad)\b", convention.meaning)
-        if whole and _parse_program(convention.program, profile) is not None:
-            out.append(convention)
-    return out
+    return [c for c in conventions
+            if c.whole_command and c.task and _parse_program(c.program, profile) is not None]
 
 
 def _parse_program(text: str, profile: Profile) -> list[Command] | None:
@@ -467,6 +461,12 @@ class Generator:
             clause = self.other(role)
         return clause if clause is not None else self.other(role)
 
+    def step(self) -> Clause:
+        """One clause of a multi-step task; whole-command conventions ("look around") among them."""
+        if self.whole and self.rng.random() < 0.12:
+            return self.whole_convention() or self.simple()
+        return self.simple()
+
     def fetch(self) -> list[Clause]:
         """Searching, approaching and grasping one object, with "it" references."""
         obj = self.rng.choice(OBJECTS)
@@ -580,7 +580,7 @@ class Generator:
             clause = self.whole_convention() or self.simple()
             text, commands, group = clause.text, list(clause.commands), "ambiguous"
         elif r < 0.72:
-            clauses = [self.simple() for _ in range(self.rng.choice((2, 2, 2, 3, 3, 4)))]
+            clauses = [self.step() for _ in range(self.rng.choice((2, 2, 2, 3, 3, 4)))]
             text = self._join([c.text for c in clauses])
             commands = [c for clause in clauses for c in clause.commands]
             group = "multi-step"
@@ -632,7 +632,8 @@ class Generator:
                 continue
             seen.add(normalized)
             program = Plan(tuple(commands), self.profile.name).to_rsl()
-            out.append(Pair(task=text, normalized=normalized, program=program, group=group))
+            out.append(Pair(task=text, normalized=normalized, program=program, group=group,
+                            prompt=adapter_prompt(normalized, self.profile)))
         return out
 
 

@@ -1,9 +1,10 @@
-"""Score an adapter on held-out synthetic pairs with llama.cpp, as the runtime runs it.
+"""Score an adapter on held-out synthetic pairs with llama.cpp.
 
-Each pair is prompted with `adapter_prompt`, decoded greedily (optionally
-under the profile's GBNF grammar) until the blank line that ends a program,
-and counted as exact (same canonical text) and accepted (compiles, and the
-plan matches with numbers within `TOLERANCE`).
+Two ways: the adapter alone (each pair's prompt decoded greedily, optionally
+under the profile's GBNF grammar, until the blank line that ends a program),
+and as the runtime runs it (the raw task through the `Translator`). A pair
+counts as exact (same canonical text) and accepted (compiles, and the plan
+matches with numbers within `TOLERANCE`).
 """
 
 from __future__ import annotations
@@ -16,7 +17,6 @@ from pathlib import Path
 from typing import Any
 
 from agent.adapter.data import Pair
-from agent.adapter.prompt import adapter_prompt
 from rsl.compiler import compile_program
 from rsl.plan import Plan, Quantity
 from rsl.profile import Profile
@@ -73,6 +73,7 @@ def complete(llm: Any, prompt: str, grammar: Any = None, max_tokens: int = MAX_T
 
 def evaluate(llm: Any, pairs: Sequence[Pair], profile: Profile, *, grammar: bool = False,
              progress: Callable[[int, int], None] | None = None) -> Score:
+    """The adapter alone: each pair's whole task prompted once, greedy, no repair."""
     gbnf = None
     if grammar:
         from llama_cpp import LlamaGrammar
@@ -80,16 +81,31 @@ def evaluate(llm: Any, pairs: Sequence[Pair], profile: Profile, *, grammar: bool
         from rsl.grammar import to_gbnf
 
         gbnf = LlamaGrammar.from_string(to_gbnf(profile), verbose=False)
+
+    def write(pair: Pair) -> str:
+        # A program has fewer tokens than characters; a runaway answer is cut there, not at MAX_TOKENS.
+        return complete(llm, pair.prompt, gbnf, max_tokens=len(pair.program) + 16)
+
+    return _score(pairs, profile, write, progress)
+
+
+def evaluate_translator(translator: Any, pairs: Sequence[Pair], profile: Profile, *,
+                        progress: Callable[[int, int], None] | None = None) -> Score:
+    """As the runtime runs it: the raw task through `Translator` (clauses, grammar, repair)."""
+    return _score(pairs, profile, lambda pair: str(translator.translate(pair.task).program), progress)
+
+
+def _score(pairs: Sequence[Pair], profile: Profile, write: Callable[[Pair], str],
+           progress: Callable[[int, int], None] | None) -> Score:
     exact = accepted = 0
     groups: dict[str, list[int]] = {}
     latencies = []
     failures = []
     for index, pair in enumerate(pairs):
         started = time.perf_counter()
-        # A program has fewer tokens than characters; a runaway answer is cut there, not at MAX_TOKENS.
-        text = complete(llm, adapter_prompt(pair.normalized), gbnf, max_tokens=len(pair.program) + 16)
+        text = write(pair)
         latencies.append((time.perf_counter() - started) * 1000)
-        got = text.strip() + "\n"
+        got = "".join(line.strip() + "\n" for line in text.splitlines() if line.strip())
         want = compile_program(pair.program, profile).plan
         result = compile_program(got, profile)
         ok = result.ok and want is not None and result.plan is not None and same_plan(result.plan, want)

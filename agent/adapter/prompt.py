@@ -1,6 +1,6 @@
 """The prompt format the RSL adapter is trained on, shared by training and runtime.
 
-The adapter learns to continue `adapter_prompt(task)` with the canonical RSL
+The adapter learns to continue `adapter_prompt(task, profile)` with the canonical RSL
 program: one `kw a, b;` statement per line, closed by an empty line, exactly
 the text `rsl.grammar.to_gbnf` accepts. So the grammar, the trained adapter and
 the runtime prompt must agree on this one function; change it only together
@@ -9,12 +9,16 @@ with a retrain.
 
 from __future__ import annotations
 
+import re
 from importlib import resources
 from pathlib import Path
 
+from agent.normalize import normalize_task
+from rsl.profile import Profile
+
 # Bumped whenever the prompt text changes; the adapter card records it and the
 # runtime can refuse an adapter trained on another format.
-PROMPT_VERSION = 1
+PROMPT_VERSION = 2
 
 ADAPTER_FILE = "rsl-default-gemma3-270m-q4km.gguf"
 CARD_FILE = "rsl-default-gemma3-270m-q4km.json"
@@ -31,17 +35,38 @@ DEFAULT_ADAPTER_CARD: Path = _adapters_dir() / CARD_FILE
 PROGRAM_END = "\n"
 
 
-def adapter_prompt(normalized_task: str) -> str:
+def convention_notes(normalized_task: str, profile: Profile) -> list[str]:
+    """The profile's conventions for the vague phrases the task uses, one note each.
+
+    A whole command ("look around") is noted with its program, an amount ("a
+    little") with its meaning. The adapter learns to follow the notes, so the
+    profile, not the training data alone, decides what a vague phrase does,
+    and a phrase the data rarely shows on its own still gets its program.
+    """
+    notes = []
+    for convention in profile.conventions:
+        phrase = normalize_task(convention.phrase)
+        if phrase != convention.phrase.lower():
+            continue  # the normalizer already writes it as a number ("a full circle" -> "6.2832 rad")
+        if not phrase or not re.search(rf"\b{re.escape(phrase)}\b", normalized_task):
+            continue
+        meaning = " ".join(convention.program.split()) if convention.whole_command else convention.meaning
+        notes.append(f"{phrase} = {meaning}")
+    return notes
+
+
+def adapter_prompt(normalized_task: str, profile: Profile) -> str:
     """The text the model continues with an RSL program for `normalized_task`.
 
     `normalized_task` is the output of `agent.normalize.normalize_task`; the
     adapter was trained on normalized text only.
     """
     task = " ".join(normalized_task.split())
-    return f"Task: {task}\nRSL:\n"
+    notes = "".join(f"Note: {note}\n" for note in convention_notes(task, profile))
+    return f"Task: {task}\n{notes}RSL:\n"
 
 
-def training_text(normalized_task: str, program: str) -> tuple[str, str]:
+def training_text(prompt: str, program: str) -> tuple[str, str]:
     """(prompt, completion) for one training pair; `program` is canonical RSL."""
     body = program if program.endswith("\n") else program + "\n"
-    return adapter_prompt(normalized_task), body + PROGRAM_END
+    return prompt, body + PROGRAM_END

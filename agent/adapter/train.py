@@ -98,7 +98,7 @@ def encode(tokenizer: Any, pairs: Sequence[Pair]) -> list[tuple[list[int], list[
     eos = tokenizer.eos_token_id
     out = []
     for pair in pairs:
-        prompt, answer = training_text(pair.normalized, pair.program)
+        prompt, answer = training_text(pair.prompt, pair.program)
         prompt_ids = [bos, *tokenizer.encode(prompt, add_special_tokens=False)]
         answer_ids = [*tokenizer.encode(answer, add_special_tokens=False), eos]
         ids = prompt_ids + answer_ids

@@ -110,7 +110,8 @@ params = [{ name = "width", kind = "number", unit = "m", min = 0.05, max = 0.5 }
 
 
 def test_a_program_that_does_not_compile_is_refused(profile: Profile) -> None:
-    bad = Pair(task="drive 99 meters", normalized="drive 99 m", program="forward 99;\n", group="simple")
+    bad = Pair(task="drive 99 meters", normalized="drive 99 m", program="forward 99;\n", group="simple",
+               prompt=adapter_prompt("drive 99 m", profile))
     with pytest.raises(ValueError, match="does not compile"):
         check_programs([*generate(profile, 5, seed=0), bad], profile)
 
@@ -121,8 +122,29 @@ def test_number_words() -> None:
     assert all(normalize_task(f"{number_words(n)} meters") == f"{n} m" for n in range(1, 200, 7))
 
 
-def test_prompt_and_completion_match_the_grammar_format() -> None:
-    prompt, completion = training_text("move forward 2 m", "forward 2;\n")
-    assert prompt == adapter_prompt("move  forward 2 m")
+def test_prompt_and_completion_match_the_grammar_format(profile: Profile) -> None:
+    prompt, completion = training_text(adapter_prompt("move  forward 2 m", profile), "forward 2;\n")
+    assert prompt == "Task: move forward 2 m\nRSL:\n"
     assert completion == "forward 2;\n\n"
+
+
+def test_the_prompt_notes_the_conventions_the_task_uses(profile: Profile) -> None:
+    look_around = next(c for c in profile.conventions if c.phrase == "look around")
+    little = next(c for c in profile.conventions if c.phrase == "a little")
+    prompt = adapter_prompt("look around, then move forward a little", profile)
+    # A whole command is noted with its program, an amount with its meaning.
+    assert f"Note: look around = {' '.join(look_around.program.split())}\n" in prompt
+    assert f"Note: a little = {little.meaning}\n" in prompt
+    assert prompt.endswith("RSL:\n")
+    # Only phrases the task uses, as whole words.
+    assert "Note" not in adapter_prompt("look around2 the corner", profile)
+    # "a full circle" is already a number once normalized: no note repeats it.
+    assert "Note" not in adapter_prompt(normalize_task("spin in a full circle"), profile)
+
+
+def test_training_prompts_carry_the_notes(profile: Profile) -> None:
+    pairs = generate(profile, 400, seed=3)
+    noted = [p for p in pairs if "look around" in p.normalized]
+    assert noted and all(p.prompt == adapter_prompt(p.normalized, profile) for p in pairs)
+    assert all("Note: look around = " in p.prompt for p in noted)
     assert load_profile().skill("forward") is not None

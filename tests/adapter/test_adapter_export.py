@@ -10,6 +10,7 @@ import pytest
 from agent.adapter.evaluate import complete, load
 from agent.adapter.export import gguf_tensor_name, write_lora_gguf
 from agent.adapter.prompt import adapter_prompt
+from rsl.profile import load_profile
 from tests.adapter.conftest import requires
 
 
@@ -47,7 +48,7 @@ def test_llama_cpp_loads_the_adapter_and_it_changes_the_output(base_gguf: Path, 
     assert fields["adapter.lora.alpha"].contents() == pytest.approx(8)
     assert not list(tmp_path.glob("*.partial"))
 
-    prompt = adapter_prompt("move forward 2 m")
+    prompt = adapter_prompt("move forward 2 m", load_profile())
     plain = complete(base, prompt, max_tokens=12)
     adapted = complete(load(base_gguf, path, threads=1), prompt, max_tokens=12)
     assert adapted != plain

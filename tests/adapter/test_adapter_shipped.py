@@ -36,6 +36,6 @@ def adapted(base_gguf: Path):
 
 
 @pytest.mark.parametrize("task", sorted(COMMANDS))
-def test_the_adapter_writes_the_program(adapted, task: str) -> None:
-    got = complete(adapted, adapter_prompt(normalize_task(task)), max_tokens=40)
+def test_the_adapter_writes_the_program(adapted, profile: Profile, task: str) -> None:
+    got = complete(adapted, adapter_prompt(normalize_task(task), profile), max_tokens=40)
     assert got.strip() + "\n" == COMMANDS[task]

@@ -8,7 +8,6 @@ from pathlib import Path
 from agent.adapter.card import read_card
 from agent.adapter.data import generate
 from agent.adapter.evaluate import complete, load
-from agent.adapter.prompt import adapter_prompt
 from agent.adapter.train import Recipe, train
 from rsl.profile import Profile
 from tests.adapter.conftest import requires
@@ -29,7 +28,7 @@ def test_a_few_steps_lower_the_loss_and_change_llama_cpp_output(profile: Profile
     assert any(line.startswith("step 12/12") and "loss" in line for line in lines)
     assert out.stat().st_size > 0
 
-    prompt = adapter_prompt(pairs[0].normalized)
+    prompt = pairs[0].prompt
     plain = complete(load(base_gguf, None, threads=1), prompt, max_tokens=12)
     adapted = complete(load(base_gguf, out, threads=1), prompt, max_tokens=12)
     assert adapted != plain
