@@ -15,9 +15,10 @@ def add_model_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--model", metavar="NAME|PATH",
                         help="GGUF model file or a name from `nrtrans models list` "
                              "(default: the embedded Gemma 3 270M)")
-    parser.add_argument("--adapter", metavar="PATH|default",
-                        help="LoRA adapter GGUF, or `default` for the shipped adapter of the default model "
-                             "(default: none; it measured below shots and narrowing, see docs/translate.md)")
+    parser.add_argument("--adapter", metavar="PATH|default|none",
+                        help="LoRA adapter GGUF, `default` for the shipped RSL adapter, or `none` for the base "
+                             "model prompted with worked examples (default: the shipped adapter when the model "
+                             "and the profile are the ones it was trained for, see docs/adapter.md)")
     parser.add_argument("--max-passes", type=int, default=3, metavar="N",
                         help="generate-and-compile passes before giving up (default: 3)")
     parser.add_argument("--no-grammar", action="store_true",

@@ -72,6 +72,11 @@ class Options:
     prefix_shots: bool = True
     split_clauses: bool = True
     narrow: bool = True
+    # Narrowing to the skills a clause's words name is a crutch for a model
+    # that does not know RSL; an adapter that learned the mapping from many
+    # phrasings is more often right than the word match ("pan the head left"
+    # names `turnleft` by its alias "left"). Objects and numbers stay narrowed.
+    narrow_skills: bool = True
     adapter_prompt: bool = False
 
 
@@ -110,8 +115,9 @@ class Translator:
              split_clauses: bool = True, narrow: bool = True, prefix_shots: bool = True) -> Translator:
         """Load the model (or connect to `endpoint`).
 
-        `adapter`: None or "none" for no adapter, "default" for the shipped
-        adapter of the embedded default model, or the path of a LoRA GGUF.
+        `adapter`: None for the shipped adapter when it fits the model and
+        profile, "none" for no adapter, "default" for the shipped adapter of
+        the embedded default model, or the path of a LoRA GGUF.
         `shots`: None picks the mode's default.
         """
         if max_passes < 1:
@@ -127,14 +133,14 @@ class Translator:
             from agent.translate.model_path import resolve_model
 
             path = resolve_model(model)
-            lora = _resolve_adapter(adapter, default_model=model in (None, "", "default"))
+            lora = _resolve_adapter(adapter, default_model=model in (None, "", "default"), profile=profile)
             engine = LocalEngine(path, lora_path=lora)
             name = path.name + (f"+{lora.name}" if lora else "")
         use_adapter = lora is not None
         options = Options(grammar=grammar, max_passes=max_passes,
                           shots=(0 if use_adapter else DEFAULT_SHOTS) if shots is None else shots,
-                          split_clauses=split_clauses, narrow=narrow, adapter_prompt=use_adapter,
-                          prefix_shots=prefix_shots and not use_adapter)
+                          split_clauses=split_clauses, narrow=narrow, narrow_skills=not use_adapter,
+                          adapter_prompt=use_adapter, prefix_shots=prefix_shots and not use_adapter)
         return cls(profile, engine, name, options)
 
     def close(self) -> None:
@@ -159,7 +165,7 @@ class Translator:
         states = [_ClauseState(c) for c in clauses]
         for state in states:
             state.objects = self._task_objects(state.clause.text)
-            if self.options.narrow:
+            if self.options.narrow and self.options.narrow_skills:
                 state.keywords, state.max_statements = self._clause_skills(state.clause.text)
         attempts: list[Attempt] = []
         pending = [s for s in states if not s.clause.repeat_previous]
@@ -195,7 +201,7 @@ class Translator:
         if self.options.adapter_prompt:
             from agent.adapter.prompt import adapter_prompt
 
-            return adapter_prompt(text) + extra
+            return adapter_prompt(text, self.profile) + extra
         shots = pick_shots(self._bank, text, self.options.shots)
         if self.engine.chat_template:
             llm = getattr(self.engine, "llm", None)
@@ -403,16 +409,17 @@ def _stem(word: str) -> str:
     return word[:-3] if word.endswith("ing") and len(word) > 5 else word
 
 
-def _resolve_adapter(adapter: str | None, *, default_model: bool) -> Path | None:
+def _resolve_adapter(adapter: str | None, *, default_model: bool, profile: Profile) -> Path | None:
     """The LoRA file to load, if any.
 
-    No adapter unless asked for: on the evaluation suite the shipped adapter
-    scored below the base model with shots and narrowing (docs/translate.md).
-    "default" picks the shipped adapter for the embedded default model.
+    None (not asked): the shipped adapter, when the model is the embedded
+    default and the profile is the one the adapter was trained on, as its card
+    says; another robot's skills are not what it learned. "default" asks for
+    the shipped adapter whatever the profile; "none" turns adapters off.
     """
-    if adapter is None or adapter.lower() in ("none", "off", ""):
+    if adapter is not None and adapter.lower() in ("none", "off", ""):
         return None
-    if adapter.lower() == "default":
+    if adapter is None or adapter.lower() == "default":
         if not default_model:
             return None
         from agent.adapter.prompt import DEFAULT_ADAPTER
@@ -421,12 +428,45 @@ def _resolve_adapter(adapter: str | None, *, default_model: bool) -> Path | None
             from agent.translate.model_path import ModelNotFoundError
 
             raise ModelNotFoundError(f"the shipped adapter {DEFAULT_ADAPTER} is missing. Reinstall nrtrans, "
-                                     "or train one with `nrtrans train-adapter`.")
-        return DEFAULT_ADAPTER
-    path = Path(adapter).expanduser()
-    if not path.is_file():
+                                     "train one with `nrtrans train-adapter`, or pass --adapter none.")
+        if adapter is None and not _trained_for(DEFAULT_ADAPTER, profile):
+            return None
+        path = DEFAULT_ADAPTER
+    else:
+        path = Path(adapter).expanduser()
+        if not path.is_file():
+            from agent.translate.model_path import ModelNotFoundError
+
+            raise ModelNotFoundError(f"no adapter at {path}: the file does not exist. Give the path of a LoRA "
+                                     "GGUF file, or train one with `nrtrans train-adapter`.")
+    _check_prompt_version(path)
+    return path
+
+
+def _trained_for(adapter: Path, profile: Profile) -> bool:
+    from agent.adapter.card import card_path, read_card
+
+    try:
+        return read_card(card_path(adapter)).profile_sha256 == profile.digest
+    except ValueError:
+        return False
+
+
+def _check_prompt_version(adapter: Path) -> None:
+    """Refuse an adapter trained on another prompt format: it would be prompted wrongly and guess."""
+    from agent.adapter.card import card_path, read_card
+    from agent.adapter.prompt import PROMPT_VERSION
+
+    card = card_path(adapter)
+    if not card.is_file():
+        return
+    try:
+        trained = read_card(card).prompt_version
+    except ValueError:
+        return
+    if trained != PROMPT_VERSION:
         from agent.translate.model_path import ModelNotFoundError
 
-        raise ModelNotFoundError(f"no adapter at {path}: the file does not exist. Give the path of a LoRA "
-                                 "GGUF file, or train one with `nrtrans train-adapter`.")
-    return path
+        raise ModelNotFoundError(f"adapter {adapter.name} was trained on prompt format {trained}, but this "
+                                 f"nrtrans writes format {PROMPT_VERSION}. Retrain it with `nrtrans "
+                                 "train-adapter`, or pass --adapter none.")

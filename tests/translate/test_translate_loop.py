@@ -106,16 +106,51 @@ def test_missing_model_gives_a_clear_error(profile: Profile, tmp_path) -> None:
         Translator.load(profile, adapter=str(tmp_path / "missing-adapter.gguf"))
 
 
-def test_adapter_mode_uses_the_lora_and_stays_verified(profile: Profile) -> None:
+def test_the_shipped_adapter_is_the_default_and_stays_verified(profile: Profile) -> None:
     from agent.adapter.prompt import DEFAULT_ADAPTER
 
-    if not DEFAULT_ADAPTER.is_file():
-        pytest.skip("no shipped adapter in models/adapters/")
-    adapted = Translator.load(profile, adapter="default")
+    adapted = Translator.load(profile)
     try:
         assert adapted.options.adapter_prompt and adapted.options.shots == 0
+        assert not adapted.options.narrow_skills and adapted.options.narrow
         assert adapted.model_name.endswith("+" + DEFAULT_ADAPTER.name)
         result = adapted.translate("pick up the cup", known_objects=["cup"])
         assert result.verified and result.program == "grasp cup;\n"
+        # The convention's program comes from the profile through the prompt's note.
+        result = adapted.translate("look around")
+        assert result.verified
+        look_around = next(c for c in profile.conventions if c.phrase == "look around")
+        expected = compile_program(look_around.program, profile).plan
+        assert result.plan is not None and expected is not None
+        assert result.plan.to_rsl() == expected.to_rsl()
     finally:
         adapted.close()
+
+
+def test_no_adapter_for_another_robot_or_when_turned_off() -> None:
+    from agent.translate.translator import _resolve_adapter
+    from rsl.profile import default_profile_path, parse_profile
+
+    text = default_profile_path().read_text("utf-8")
+    other_robot = parse_profile(text.replace('name = "default"', 'name = "other"'))
+    default = parse_profile(text)
+    assert _resolve_adapter(None, default_model=True, profile=default) is not None
+    assert _resolve_adapter(None, default_model=True, profile=other_robot) is None
+    assert _resolve_adapter(None, default_model=False, profile=default) is None
+    assert _resolve_adapter("none", default_model=True, profile=default) is None
+    # Asked for by name, it loads for any profile.
+    assert _resolve_adapter("default", default_model=True, profile=other_robot) is not None
+
+
+def test_an_adapter_for_another_prompt_format_is_refused(profile: Profile, tmp_path) -> None:
+    import shutil
+
+    from agent.adapter.card import card_path, read_card
+    from agent.adapter.prompt import DEFAULT_ADAPTER, PROMPT_VERSION
+
+    adapter = tmp_path / "old.gguf"
+    shutil.copyfile(DEFAULT_ADAPTER, adapter)
+    old = dataclasses.replace(read_card(card_path(DEFAULT_ADAPTER)), prompt_version=PROMPT_VERSION - 1)
+    old.write(card_path(adapter))
+    with pytest.raises(ModelNotFoundError, match="prompt format"):
+        Translator.load(profile, adapter=str(adapter))
