@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
+import os
 import platform
 import sys
 import time
@@ -36,9 +38,10 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--lr", type=float, default=3e-4, metavar="RATE", help="peak learning rate (3e-4)")
     parser.add_argument("--rank", type=int, default=16, metavar="R", help="LoRA rank (default 16)")
     parser.add_argument("--seed", type=int, default=0, help="seed for data, order and weights (default 0)")
-    parser.add_argument("--threads", type=int, default=1, metavar="N",
-                        help="CPU threads for training (default 1: on a CPU shared with other work, one "
-                             "thread is several times faster than two that wait for each other)")
+    parser.add_argument("--threads", type=int, default=0, metavar="N",
+                        help="CPU threads for training (default: every core when the machine is idle, one "
+                             "when it is busy; on a CPU shared with other work, one thread was several times "
+                             "faster than two that wait for each other)")
     parser.add_argument("--eval", type=int, default=60, metavar="N", dest="eval_pairs",
                         help="held-out synthetic pairs to score the adapter on with llama.cpp (default 60; "
                              "0 skips)")
@@ -56,6 +59,9 @@ def _train(args: argparse.Namespace) -> int:
         if getattr(args, name) < 1:
             print(f"nrtrans train-adapter: error: --{name} must be at least 1", file=sys.stderr)
             return EXIT_USAGE
+    if args.threads < 0:
+        print("nrtrans train-adapter: error: --threads must be 0 (automatic) or more", file=sys.stderr)
+        return EXIT_USAGE
     from agent.adapter.card import AdapterCard, card_path, sha256_of
     from agent.adapter.data import generate
     from agent.adapter.hygiene import eval_tasks, held_out_filter
@@ -89,11 +95,14 @@ def _train(args: argparse.Namespace) -> int:
     if args.dump_data:
         with open(args.dump_data, "w", encoding="utf-8") as handle:
             for pair in pairs:
-                handle.write(json.dumps({"task": pair.task, "normalized": pair.normalized,
+                handle.write(json.dumps({"task": pair.task, "normalized": pair.normalized, "prompt": pair.prompt,
                                          "program": pair.program, "group": pair.group}) + "\n")
 
+    threads = args.threads or _auto_threads()
+    print(f"training with {threads} CPU thread(s)", file=sys.stderr)
+
     recipe = Recipe(steps=args.steps, batch=args.batch, learning_rate=args.lr, rank=args.rank,
-                    alpha=2.0 * args.rank, seed=args.seed, threads=args.threads)
+                    alpha=2.0 * args.rank, seed=args.seed, threads=threads)
     base_sha = sha256_of(base)
     try:
         result = train(pairs, base, out, recipe, metadata={
@@ -101,23 +110,6 @@ def _train(args: argparse.Namespace) -> int:
             "prompt_version": str(PROMPT_VERSION)})
     except TrainingError as exc:
         return _fail(str(exc))
-
-    scores: dict[str, Any] = {}
-    if held_out:
-        from agent.adapter.evaluate import evaluate, load
-
-        print(f"scoring the adapter on {len(held_out)} held-out synthetic pairs with llama.cpp ...",
-              file=sys.stderr)
-        llm = load(base, out, threads=args.threads or None)
-
-        def report(done: int, total: int) -> None:
-            if done % 10 == 0 or done == total:
-                print(f"  {done}/{total}", file=sys.stderr, flush=True)
-
-        score = evaluate(llm, held_out, profile, progress=report)
-        scores = {"synthetic_held_out": score.to_dict()}
-        for task, want, got in score.failures[:5]:
-            print(f"  miss: {task!r}\n    want {want.strip()!r}\n    got  {got.strip()!r}", file=sys.stderr)
 
     import torch
 
@@ -136,10 +128,59 @@ def _train(args: argparse.Namespace) -> int:
                   "loss_every_50": [round(x, 4) for x in result.losses[::50]],
                   "train_seconds": round(result.seconds, 1),
                   "total_seconds": round(time.monotonic() - started, 1), "device": result.device,
-                  "torch": torch.__version__, "machine": platform.machine()},
-        eval=scores)
+                  "threads": recipe.threads, "torch": torch.__version__, "machine": platform.machine()})
+    # Written before scoring too: the runtime reads the card (prompt format) when it loads the adapter.
+    card.write(card_path(out))
+    if held_out:
+        card = dataclasses.replace(card, eval=_score(base, out, held_out, profile, threads))
     card.write(card_path(out))
     print(f"wrote {out} and {card_path(out)}", file=sys.stderr)
-    if scores:
-        print(json.dumps(scores, indent=2))
+    if card.eval:
+        print(json.dumps(card.eval, indent=2))
     return 0
+
+
+def _auto_threads() -> int:
+    cores = os.cpu_count() or 1
+    return cores if os.getloadavg()[0] < 1.0 else 1
+
+
+def _score(base: Path, adapter: Path, held_out: list[Any], profile: Any, threads: int) -> dict[str, Any]:
+    """The card's eval figures: held-out pairs by the adapter alone and as the runtime runs them, and
+    the evaluation suite when it is written for this profile."""
+    from agent.adapter.evaluate import evaluate, evaluate_translator, load
+    from agent.evalsuite import load_suite
+    from agent.evalsuite.runner import render_table, run_suite, summarize
+    from agent.evalsuite.suite import SuiteError
+    from agent.translate import Translator
+
+    def report(done: int, total: int) -> None:
+        if done % 20 == 0 or done == total:
+            print(f"  {done}/{total}", file=sys.stderr, flush=True)
+
+    print(f"scoring the adapter alone on {len(held_out)} held-out synthetic pairs with llama.cpp ...",
+          file=sys.stderr)
+    alone = evaluate(load(base, adapter, threads=threads or None), held_out, profile, progress=report)
+    for task, want, got in alone.failures[:5]:
+        print(f"  miss: {task!r}\n    want {want.strip()!r}\n    got  {got.strip()!r}", file=sys.stderr)
+    scores: dict[str, Any] = {"synthetic_held_out": alone.to_dict()}
+    translator = Translator.load(profile, model=str(base), adapter=str(adapter))
+    try:
+        print("scoring it as the runtime runs it (clauses, grammar, repair) ...", file=sys.stderr)
+        scores["synthetic_held_out_runtime"] = evaluate_translator(translator, held_out, profile,
+                                                                   progress=report).to_dict()
+        try:
+            tasks = load_suite(profile=profile)
+        except SuiteError as exc:
+            print(f"not running the evaluation suite: {exc}", file=sys.stderr)
+        else:
+            print(f"running the evaluation suite ({len(tasks)} tasks) ...", file=sys.stderr)
+            table = summarize(run_suite(translator, tasks, profile))
+            print(render_table(table), file=sys.stderr)
+            scores["eval_suite"] = {group: {"n": int(row["n"]), "accuracy": round(row["accuracy"], 4),
+                                            "verified": round(row["success"], 4),
+                                            "latency_p50_ms": round(row["latency_p50_ms"], 1)}
+                                    for group, row in table.items()}
+    finally:
+        translator.close()
+    return scores
