@@ -28,6 +28,11 @@ def test_the_card_describes_the_shipped_adapter(base_gguf: Path, profile: Profil
     assert card.profile_name == profile.name
     assert card.training["final_loss"] < card.training["first_loss"]
     assert "Gemma Terms of Use" in card.licence
+    # The figures train-adapter measured for it: the shipped adapter must meet the suite's targets.
+    suite = card.eval["eval_suite"]
+    assert suite["overall"]["n"] == 108 and suite["overall"]["verified"] == 1.0
+    assert suite["overall"]["accuracy"] >= 0.95
+    assert all(row["accuracy"] >= 0.85 for row in suite.values()), suite
 
 
 @pytest.fixture(scope="module")
