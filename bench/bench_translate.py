@@ -5,7 +5,7 @@ request) and reports p50/p95 of the whole loop; then, side by side on the
 same tasks, the prompt time of a request whose fixed prefix is cached vs one
 whose cache was cleared first. Writes bench/results/translate.json.
 
-    python bench/bench_translate.py [--model PATH] [--adapter PATH|default] [--tasks 40]
+    python bench/bench_translate.py [--model PATH] [--adapter PATH|none] [--tasks 40]
 """
 
 from __future__ import annotations
@@ -28,7 +28,8 @@ from rsl.profile import load_profile
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--model", help="GGUF model (default: the embedded Gemma 3 270M)")
-    parser.add_argument("--adapter", help="LoRA adapter GGUF, or default for the shipped one (default: none)")
+    parser.add_argument("--adapter", help="LoRA adapter GGUF, or none for the base model with shots "
+                                          "(default: the shipped adapter, as the runtime loads it)")
     parser.add_argument("--tasks", type=int, default=40)
     parser.add_argument("--out", default="bench/results/translate.json")
     args = parser.parse_args()
