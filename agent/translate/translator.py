@@ -8,6 +8,7 @@ compiles without a diagnostic comes back with a plan.
 
 from __future__ import annotations
 
+import difflib
 import itertools
 import re
 import threading
@@ -188,6 +189,8 @@ class Translator:
             if result.ok:
                 break
             pending = self._prepare_repair(states, result.diagnostics, known)
+            if not pending:
+                break
         assert result is not None
         timings["total"] = (time.perf_counter() - started) * 1000
         verified = result.ok
@@ -323,6 +326,7 @@ class Translator:
 
     def _prepare_repair(self, states: list[_ClauseState], diagnostics: tuple[Diagnostic, ...],
                         known: Collection[str] | None) -> list[_ClauseState]:
+        """The clauses to write again, with feedback; none when no repair can do what was asked."""
         failing: list[_ClauseState] = []
         for state in states:
             if state.clause.repeat_previous:
@@ -330,8 +334,14 @@ class Translator:
             mine = [d for d in diagnostics if state.lines[0] <= d.line <= state.lines[1]]
             if not mine:
                 continue
-            if any(d.code is Code.UNKNOWN_OBJECT for d in mine) and known:
-                state.objects = tuple(sorted(known))
+            unknown = [d.token for d in mine if d.code is Code.UNKNOWN_OBJECT]
+            if unknown and known:
+                likely = _likely_meant(unknown, known)
+                if not likely:
+                    # "grasp the mug" when only a cup is known asks for another object, not a slip of
+                    # the ear: a repair would pick up the wrong thing, so the unknown name is the answer.
+                    return []
+                state.objects = likely
             if any(d.code in _RANGE_CODES for d in mine):
                 state.free_numbers = True
             state.extra = feedback(state.program, mine)
@@ -342,6 +352,15 @@ class Translator:
         for state in generic:
             state.extra = feedback(state.program, diagnostics)
         return generic
+
+
+def _likely_meant(names: Collection[str], known: Collection[str]) -> tuple[str, ...]:
+    """Known objects an unknown name could be a mishearing or a longer name of ("cop" -> cup)."""
+    likely: set[str] = set()
+    for name in names:
+        likely.update(difflib.get_close_matches(name, list(known), n=3, cutoff=0.6))
+        likely.update(k for k in known if k in name.split("_") or name in k.split("_"))
+    return tuple(sorted(likely))
 
 
 def _tidy(text: str) -> str:

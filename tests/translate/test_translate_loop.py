@@ -46,14 +46,33 @@ def test_grammar_makes_syntax_errors_impossible(translator: Translator, task: st
     assert result.verified, result.attempts
 
 
-def test_loop_repairs_an_unknown_object(translator: Translator) -> None:
-    """The task names a mug, the robot only knows a cup: the compiler's E104 drives a second pass."""
+def test_loop_repairs_a_misheard_object(translator: Translator) -> None:
+    """The task names a cop, the robot knows a cup: the compiler's E104 drives a second pass."""
     seen = []
-    result = translator.translate("grasp the mug", known_objects=["cup"], on_attempt=seen.append)
+    result = translator.translate("grasp the cop", known_objects=["cup", "table"], on_attempt=seen.append)
     assert len(seen) == result.passes == 2
     assert [d.code for d in result.attempts[0].diagnostics] == [Code.UNKNOWN_OBJECT]
     assert result.verified and result.plan is not None
     assert {c.object() for c in result.plan if c.skill in ("grasp", "approach")} == {"cup"}
+
+
+def test_another_object_is_refused_not_swapped(translator: Translator) -> None:
+    """A mug is not a misheard cup: grasping the cup instead would do what nobody asked."""
+    result = translator.translate("grasp the mug", known_objects=["cup", "table"])
+    assert result.passes == 1 and not result.verified and result.plan is None
+    [diagnostic] = result.attempts[-1].diagnostics
+    assert diagnostic.code is Code.UNKNOWN_OBJECT and diagnostic.token == "mug"
+    assert "`cup`" in diagnostic.message
+
+
+def test_likely_meant_objects() -> None:
+    from agent.translate.translator import _likely_meant
+
+    known = ["cup", "red_cup", "table", "bottle"]
+    assert _likely_meant(["cop"], known) == ("cup",)
+    assert _likely_meant(["bottel"], known) == ("bottle",)
+    assert _likely_meant(["blue_cup"], known) == ("cup", "red_cup")
+    assert _likely_meant(["mug"], known) == ()
 
 
 def test_pass_cap_is_honoured(translator: Translator) -> None:
