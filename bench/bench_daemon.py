@@ -285,7 +285,7 @@ def main() -> int:
             "cpus": os.cpu_count(),
             "platform": platform.platform(),
             "python": platform.python_version(),
-            "note": "shared 2-core machine: other engineers' jobs ran side by side",
+            "load_average_at_end": round(os.getloadavg()[0], 2),
         },
         "medians": {
             "start_to_ready_s": round(median(starts), 3),
