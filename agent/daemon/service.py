@@ -198,13 +198,26 @@ class Service:
         self._stop_robot()
         with self._lock:
             self._estop_reason = reason
-            current = self._current
-        if current is not None:
-            current.cancel.set(f"emergency stop: {reason}")
-        for task in self.queue.drain():
-            self._finish(task, TaskState.CANCELLED, f"emergency stop: {reason}")
+        self._cancel_all(f"emergency stop: {reason}")
         self.events.publish("estop", None, reason=reason)
         self.on_status(f"EMERGENCY STOP latched: {reason}; send reset to resume")
+
+    def halt(self, reason: str) -> list[str]:
+        """Stop the robot and cancel the running and queued tasks, latching nothing; returns their ids."""
+        self._stop_robot()
+        return self._cancel_all(reason)
+
+    def _cancel_all(self, reason: str) -> list[str]:
+        with self._lock:
+            current = self._current
+        cancelled = []
+        if current is not None and not current.state.finished:
+            current.cancel.set(reason)
+            cancelled.append(current.id)
+        for task in self.queue.drain():
+            self._finish(task, TaskState.CANCELLED, reason)
+            cancelled.append(task.id)
+        return cancelled
 
     def reset(self) -> bool:
         with self._lock:
@@ -511,6 +524,13 @@ class Service:
     def _on_transcript(self, transcript: Any) -> None:
         text = str(transcript.text).strip()
         if not text:
+            return
+        from agent.speech.lexicon import is_stop_command
+
+        if is_stop_command(text):
+            cancelled = self.halt(f"stopped by voice: {text!r}")
+            log.info("heard %r: robot stopped, cancelled %s", text, cancelled or "nothing")
+            self.events.publish("speech", None, state="stop", detail={"text": text, "cancelled": cancelled})
             return
         heard = transcript.to_dict() if hasattr(transcript, "to_dict") else {"text": text}
 

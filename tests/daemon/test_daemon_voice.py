@@ -50,3 +50,35 @@ def test_spoken_task_is_heard_queued_and_audited(workdir: Path, mic: VirtualMic)
             client.cancel(heard["task"])
     finally:
         assert daemon.stop() == 0, daemon.output()
+
+
+def test_spoken_stop_halts_the_running_task_and_is_no_task(workdir: Path, mic: VirtualMic) -> None:
+    wav = speak("로봇 정지", workdir / "stop.wav")
+    daemon = Daemon(workdir, {"speech": {"enabled": True, "options": KOREAN}, "tasks": {"shutdown_grace": 1.0}}).start()
+    try:
+        with daemon.client(timeout=120) as client:
+            deadline = time.monotonic() + 90
+            while client.health()["components"]["speech"].get("state") != "waiting_for_wake_word":
+                assert time.monotonic() < deadline, client.health()["components"]["speech"]
+                time.sleep(0.2)
+            client.subscribe()
+            task = client.submit(rsl="forward 5;")
+            next(e for e in client.events() if e["event"] == "executing" and e["task"] == task)
+            mic.play(wav)
+            events = []
+            for event in client.events():
+                events.append(check_frame(event))
+                if event["event"] == "speech" and event["state"] == "stop":
+                    break
+            assert events[-1]["detail"]["cancelled"] == [task], events[-1]
+            assert not any(e["event"] in ("heard", "queued") for e in events), "a spoken stop became a task"
+            ended = next(check_frame(e) for e in client.events() if e["task"] == task and e["event"] != "step")
+            assert ended["event"] == "cancelled" and "stopped by voice" in ended["reason"], ended
+            pose = client.health()["components"]["robot"]["state"]["pose"]
+            time.sleep(0.5)
+            assert client.health()["components"]["robot"]["state"]["pose"]["x"] == pytest.approx(pose["x"], abs=0.01)
+            assert pose["x"] < 4.5, "the robot stopped before the end of the drive"
+            # Nothing is latched: the next task runs.
+            assert client.status()["state"] != "estopped"
+    finally:
+        assert daemon.stop() == 0, daemon.output()

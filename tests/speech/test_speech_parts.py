@@ -15,7 +15,7 @@ from agent.speech import SpeechConfig, SpeechConfigError
 from agent.speech.audio import Audio, AudioFileError, read_wav, resample
 from agent.speech.endpoint import SilenceDetector
 from agent.speech.feedback import Speaker, describe, number_words
-from agent.speech.lexicon import ENGLISH, KOREAN, lexicon_for
+from agent.speech.lexicon import ENGLISH, KOREAN, is_stop_command, lexicon_for
 from agent.speech.recognizer import load_model, transcribe
 from agent.speech.spotting import trim_leading_quiet, words_after
 from agent.speech.vocabulary import build_vocabulary, supports_runtime_grammar, wanted_words
@@ -194,3 +194,19 @@ def test_speech_input_announces_steps_only_when_asked(profile, monkeypatch: pyte
     talking = SpeechInput(SpeechConfig(enabled=False, feedback=True), lambda t: None)
     assert talking.announce(plan.commands[0])
     talking.stop()
+
+
+@pytest.mark.parametrize("said", ["stop", "Stop!", "robot, stop right now", "stop stop", "halt", "cancel that",
+                                  "never mind", "emergency stop", "로봇 정지", "멈춰"])
+def test_an_utterance_that_only_says_stop_is_a_stop(said: str) -> None:
+    assert is_stop_command(said)
+
+
+@pytest.mark.parametrize("said", ["drive to the table and stop", "stop at the door", "turn right", "robot", "",
+                                  "please", "로봇 앞으로"])
+def test_a_task_that_mentions_stopping_is_a_task(said: str) -> None:
+    assert not is_stop_command(said)
+
+
+def test_stop_words_are_in_the_biasing_vocabulary(profile) -> None:
+    assert {"stop", "halt", "cancel"} <= set(wanted_words(profile, ENGLISH))
