@@ -85,6 +85,7 @@ def markdown_reference(profile: Profile) -> str:
         "",
         "`nrtrans check FILE` reports every error with a stable code, its line and column, the token, "
         "and what to do. Codes E001-E010 are syntax errors, E101-E105 semantic ones "
-        "(range, sign, workspace, unknown object, program length).",
+        "(range, sign, workspace, unknown object, program length). E201 comes from the translator, "
+        "not the compiler: the words were not read as a task for this robot.",
         "",
     ])

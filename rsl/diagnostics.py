@@ -25,6 +25,8 @@ class Code(Enum):
     OUTSIDE_WORKSPACE = ("E103", "target outside workspace")
     UNKNOWN_OBJECT = ("E104", "unknown object")
     TOO_LONG = ("E105", "program too long")
+    # Reported by the translator, not the compiler: the words are not a task for this robot.
+    NOT_A_TASK = ("E201", "not a robot task")
 
     def __init__(self, code: str, title: str) -> None:
         self.code = code

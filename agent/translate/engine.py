@@ -33,6 +33,10 @@ class Generation:
     prompt_ms: float
     generate_ms: float
     finished: bool  # False when the token cap cut it off
+    # What the model would write first with no grammar, and how sure it is (softmax over the whole
+    # vocabulary): a clause the model does not read as a robot task shows in these.
+    first_piece: str = ""
+    first_probability: float | None = None  # None: this engine cannot tell
 
 
 def use_plain_cpu_buffers() -> None:
@@ -199,8 +203,13 @@ class LocalEngine:
         generated = 0
         finished = False
         pieces = self.vocabulary.pieces
+        first_piece, first_probability = "", 0.0
         while generated < max_tokens:
             logits = np.ctypeslib.as_array(llama_cpp.llama_get_logits_ith(llm._ctx.ctx, -1), shape=(n_vocab,))
+            if generated == 0:
+                top = int(np.argmax(logits))
+                first_probability = float(1.0 / np.exp(logits - logits[top]).sum())
+                first_piece = pieces[top].decode("utf-8", errors="replace")
             if masks is None:
                 token = int(np.argmax(logits))
                 if token == self.vocabulary.eos:
@@ -225,7 +234,7 @@ class LocalEngine:
         done = time.perf_counter()
         return Generation(text=text, prompt_tokens=len(tokens), reused_tokens=reused, generated_tokens=generated,
                           prompt_ms=(prompt_done - started) * 1000, generate_ms=(done - prompt_done) * 1000,
-                          finished=finished)
+                          finished=finished, first_piece=first_piece, first_probability=first_probability)
 
     def close(self) -> None:
         close = getattr(self.llm, "close", None)

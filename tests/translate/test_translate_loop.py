@@ -142,6 +142,11 @@ def test_the_shipped_adapter_is_the_default_and_stays_verified(profile: Profile)
         expected = compile_program(look_around.program, profile).plan
         assert result.plan is not None and expected is not None
         assert result.plan.to_rsl() == expected.to_rsl()
+        # Words that are no task are refused, not forced into a program by the grammar.
+        chat = adapted.translate("what time is it")
+        assert not chat.verified and chat.plan is None and chat.passes == 1
+        assert [d.code for d in chat.attempts[0].diagnostics][:1] == [Code.NOT_A_TASK]
+        assert "'what time is it' does not read as a task" in chat.attempts[0].diagnostics[0].message
     finally:
         adapted.close()
 
@@ -173,3 +178,19 @@ def test_an_adapter_for_another_prompt_format_is_refused(profile: Profile, tmp_p
     old.write(card_path(adapter))
     with pytest.raises(ModelNotFoundError, match="prompt format"):
         Translator.load(profile, adapter=str(adapter))
+
+
+def test_a_clause_reads_as_a_task_when_the_model_would_start_rsl_and_is_sure(profile: Profile) -> None:
+    from agent.translate.engine import Generation
+    from agent.translate.translator import UNSURE_BELOW, _reads_as_task
+
+    def first(piece: str, probability: float | None) -> Generation:
+        return Generation(text="", prompt_tokens=1, reused_tokens=0, generated_tokens=0, prompt_ms=0.0,
+                          generate_ms=0.0, finished=True, first_piece=piece, first_probability=probability)
+
+    assert _reads_as_task(first("forward", 0.99), profile)
+    assert _reads_as_task(first("look", 0.9), profile)  # a piece of `lookleft`
+    assert not _reads_as_task(first("sing", 0.99), profile)  # the model wants to write something else
+    assert not _reads_as_task(first("turn", UNSURE_BELOW / 2), profile)  # a guess
+    assert not _reads_as_task(first("", 0.99), profile)  # it would end at once
+    assert _reads_as_task(first("", None), profile)  # an engine that cannot tell refuses nothing
