@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import time
 from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -24,8 +26,9 @@ def mic() -> Iterator[VirtualMic]:
         yield virtual
 
 
-def test_spoken_task_is_heard_queued_and_audited(workdir: Path, mic: VirtualMic) -> None:
-    wav = speak("로봇 원점 이동", workdir / "task.wav")
+@contextmanager
+def _listening(workdir: Path) -> Iterator[Any]:
+    """A daemon waiting for the wake word, and a client subscribed to its events; the daemon must exit 0."""
     # The daemon inherits PULSE_SERVER etc. from the environment VirtualMic set up.
     daemon = Daemon(workdir, {"speech": {"enabled": True, "options": KOREAN}, "tasks": {"shutdown_grace": 1.0}}).start()
     try:
@@ -35,50 +38,47 @@ def test_spoken_task_is_heard_queued_and_audited(workdir: Path, mic: VirtualMic)
                 assert time.monotonic() < deadline, client.health()["components"]["speech"]
                 time.sleep(0.2)
             client.subscribe()
-            said = time.time()
-            mic.play(wav)
-            heard = next(check_frame(e) for e in client.events() if e["event"] == "heard")
-            # The speech tests' own measure: first word exact (no wake word left), at most one word in two wrong.
-            assert_heard(heard["text"], "원점 이동")
-            assert heard["source"] == "wake_word"
-            assert said - 1 <= heard["ended_at"] <= time.time()
-            queued = next(check_frame(e) for e in client.events() if e["event"] == "queued")
-            assert queued["task"] == heard["task"] and queued["source"] == "voice"
-            record = client.status(heard["task"])
-            assert record["source"] == "voice" and record["peer"] is None
-            assert record["transcript"]["text"] == heard["text"] == record["text"]
-            client.cancel(heard["task"])
+            yield client
     finally:
         assert daemon.stop() == 0, daemon.output()
+
+
+def test_spoken_task_is_heard_queued_and_audited(workdir: Path, mic: VirtualMic) -> None:
+    wav = speak("로봇 원점 이동", workdir / "task.wav")
+    with _listening(workdir) as client:
+        said = time.time()
+        mic.play(wav)
+        heard = next(check_frame(e) for e in client.events() if e["event"] == "heard")
+        # The speech tests' own measure: first word exact (no wake word left), at most one word in two wrong.
+        assert_heard(heard["text"], "원점 이동")
+        assert heard["source"] == "wake_word"
+        assert said - 1 <= heard["ended_at"] <= time.time()
+        queued = next(check_frame(e) for e in client.events() if e["event"] == "queued")
+        assert queued["task"] == heard["task"] and queued["source"] == "voice"
+        record = client.status(heard["task"])
+        assert record["source"] == "voice" and record["peer"] is None
+        assert record["transcript"]["text"] == heard["text"] == record["text"]
+        client.cancel(heard["task"])
 
 
 def test_spoken_stop_halts_the_running_task_and_is_no_task(workdir: Path, mic: VirtualMic) -> None:
     wav = speak("로봇 정지", workdir / "stop.wav")
-    daemon = Daemon(workdir, {"speech": {"enabled": True, "options": KOREAN}, "tasks": {"shutdown_grace": 1.0}}).start()
-    try:
-        with daemon.client(timeout=120) as client:
-            deadline = time.monotonic() + 90
-            while client.health()["components"]["speech"].get("state") != "waiting_for_wake_word":
-                assert time.monotonic() < deadline, client.health()["components"]["speech"]
-                time.sleep(0.2)
-            client.subscribe()
-            task = client.submit(rsl="forward 5;")
-            next(e for e in client.events() if e["event"] == "executing" and e["task"] == task)
-            mic.play(wav)
-            events = []
-            for event in client.events():
-                events.append(check_frame(event))
-                if event["event"] == "speech" and event["state"] == "stop":
-                    break
-            assert events[-1]["detail"]["cancelled"] == [task], events[-1]
-            assert not any(e["event"] in ("heard", "queued") for e in events), "a spoken stop became a task"
-            ended = next(check_frame(e) for e in client.events() if e["task"] == task and e["event"] != "step")
-            assert ended["event"] == "cancelled" and "stopped by voice" in ended["reason"], ended
-            pose = client.health()["components"]["robot"]["state"]["pose"]
-            time.sleep(0.5)
-            assert client.health()["components"]["robot"]["state"]["pose"]["x"] == pytest.approx(pose["x"], abs=0.01)
-            assert pose["x"] < 4.5, "the robot stopped before the end of the drive"
-            # Nothing is latched: the next task runs.
-            assert client.status()["state"] != "estopped"
-    finally:
-        assert daemon.stop() == 0, daemon.output()
+    with _listening(workdir) as client:
+        task = client.submit(rsl="forward 5;")
+        next(e for e in client.events() if e["event"] == "executing" and e["task"] == task)
+        mic.play(wav)
+        events = []
+        for event in client.events():
+            events.append(check_frame(event))
+            if event["event"] == "speech" and event["state"] == "stop":
+                break
+        assert events[-1]["detail"]["cancelled"] == [task], events[-1]
+        assert not any(e["event"] in ("heard", "queued") for e in events), "a spoken stop became a task"
+        ended = next(check_frame(e) for e in client.events() if e["task"] == task and e["event"] != "step")
+        assert ended["event"] == "cancelled" and "stopped by voice" in ended["reason"], ended
+        pose = client.health()["components"]["robot"]["state"]["pose"]
+        time.sleep(0.5)
+        assert client.health()["components"]["robot"]["state"]["pose"]["x"] == pytest.approx(pose["x"], abs=0.01)
+        assert pose["x"] < 4.5, "the robot stopped before the end of the drive"
+        # Nothing is latched: the next task runs.
+        assert client.status()["state"] != "estopped"
