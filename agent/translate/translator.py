@@ -18,10 +18,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Protocol
 
+from agent.adapter.card import AdapterCard, card_path, read_card
 from agent.normalize import normalize_task
 from agent.translate.automaton import RslAutomaton
 from agent.translate.clauses import Clause, split_clauses
 from agent.translate.engine import Generation
+from agent.translate.model_path import ModelNotFoundError
 from agent.translate.prompt import (
     Shot,
     chat_prompt,
@@ -469,7 +471,9 @@ def _resolve_adapter(adapter: str | None, *, default_model: bool, profile: Profi
     None (not asked): the shipped adapter, when the model is the embedded
     default and the profile is the one the adapter was trained on, as its card
     says; another robot's skills are not what it learned. "default" asks for
-    the shipped adapter whatever the profile; "none" turns adapters off.
+    the shipped adapter whatever the profile; "none" turns adapters off. An
+    adapter whose card names another prompt format is refused: it would be
+    prompted wrongly and guess.
     """
     if adapter is not None and adapter.lower() in ("none", "off", ""):
         return None
@@ -479,48 +483,32 @@ def _resolve_adapter(adapter: str | None, *, default_model: bool, profile: Profi
         from agent.adapter.prompt import DEFAULT_ADAPTER
 
         if not DEFAULT_ADAPTER.is_file():
-            from agent.translate.model_path import ModelNotFoundError
-
             raise ModelNotFoundError(f"the shipped adapter {DEFAULT_ADAPTER} is missing. Reinstall nrtrans, "
                                      "train one with `nrtrans train-adapter`, or pass --adapter none.")
-        if adapter is None and not _trained_for(DEFAULT_ADAPTER, profile):
-            return None
         path = DEFAULT_ADAPTER
     else:
         path = Path(adapter).expanduser()
         if not path.is_file():
-            from agent.translate.model_path import ModelNotFoundError
-
             raise ModelNotFoundError(f"no adapter at {path}: the file does not exist. Give the path of a LoRA "
                                      "GGUF file, or train one with `nrtrans train-adapter`.")
-    _check_prompt_version(path)
+    card = _card_of(path)
+    if adapter is None and (card is None or card.profile_sha256 != profile.digest):
+        return None
+    from agent.adapter.prompt import PROMPT_VERSION
+
+    if card is not None and card.prompt_version != PROMPT_VERSION:
+        raise ModelNotFoundError(f"adapter {path.name} was trained on prompt format {card.prompt_version}, but "
+                                 f"this nrtrans writes format {PROMPT_VERSION}. Retrain it with `nrtrans "
+                                 "train-adapter`, or pass --adapter none.")
     return path
 
 
-def _trained_for(adapter: Path, profile: Profile) -> bool:
-    from agent.adapter.card import card_path, read_card
-
-    try:
-        return read_card(card_path(adapter)).profile_sha256 == profile.digest
-    except ValueError:
-        return False
-
-
-def _check_prompt_version(adapter: Path) -> None:
-    """Refuse an adapter trained on another prompt format: it would be prompted wrongly and guess."""
-    from agent.adapter.card import card_path, read_card
-    from agent.adapter.prompt import PROMPT_VERSION
-
+def _card_of(adapter: Path) -> AdapterCard | None:
+    """The adapter's card, or None when it has none or it cannot be read."""
     card = card_path(adapter)
     if not card.is_file():
-        return
+        return None
     try:
-        trained = read_card(card).prompt_version
+        return read_card(card)
     except ValueError:
-        return
-    if trained != PROMPT_VERSION:
-        from agent.translate.model_path import ModelNotFoundError
-
-        raise ModelNotFoundError(f"adapter {adapter.name} was trained on prompt format {trained}, but this "
-                                 f"nrtrans writes format {PROMPT_VERSION}. Retrain it with `nrtrans "
-                                 "train-adapter`, or pass --adapter none.")
+        return None
