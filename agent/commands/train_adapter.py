@@ -133,7 +133,7 @@ def _train(args: argparse.Namespace) -> int:
     card.write(card_path(out))
     if held_out:
         card = dataclasses.replace(card, eval=_score(base, out, held_out, profile, threads))
-    card.write(card_path(out))
+        card.write(card_path(out))
     print(f"wrote {out} and {card_path(out)}", file=sys.stderr)
     if card.eval:
         print(json.dumps(card.eval, indent=2))
