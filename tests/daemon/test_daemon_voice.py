@@ -27,7 +27,7 @@ def mic() -> Iterator[VirtualMic]:
 
 
 @contextmanager
-def _listening(workdir: Path) -> Iterator[tuple[Daemon, Any]]:
+def _listening(workdir: Path) -> Iterator[Any]:
     """A daemon waiting for the wake word, and a client subscribed to its events; the daemon must exit 0."""
     # The daemon inherits PULSE_SERVER etc. from the environment VirtualMic set up.
     daemon = Daemon(workdir, {"speech": {"enabled": True, "options": KOREAN}, "tasks": {"shutdown_grace": 1.0}}).start()
@@ -38,14 +38,14 @@ def _listening(workdir: Path) -> Iterator[tuple[Daemon, Any]]:
                 assert time.monotonic() < deadline, client.health()["components"]["speech"]
                 time.sleep(0.2)
             client.subscribe()
-            yield daemon, client
+            yield client
     finally:
         assert daemon.stop() == 0, daemon.output()
 
 
 def test_spoken_task_is_heard_queued_and_audited(workdir: Path, mic: VirtualMic) -> None:
     wav = speak("로봇 원점 이동", workdir / "task.wav")
-    with _listening(workdir) as (_, client):
+    with _listening(workdir) as client:
         said = time.time()
         mic.play(wav)
         heard = next(check_frame(e) for e in client.events() if e["event"] == "heard")
