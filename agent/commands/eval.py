@@ -20,8 +20,8 @@ def register(subparsers: Any) -> None:
                     "(accepted), mean passes and latency p50/p95 per group and overall.",
         epilog="Example: nrtrans eval --group units --out bench/results/eval.json")
     parser.add_argument("--group", action="append", metavar="NAME",
-                        help="only this group (repeatable): simple, ambiguous, multi-step, complex, units, "
-                             "asr-noise")
+                        help="only this group (repeatable); the suite's groups are simple, ambiguous, "
+                             "multi-step, complex, units and asr-noise, another --suite may name its own")
     parser.add_argument("--limit", type=int, metavar="N", help="only the first N tasks (after --group)")
     parser.add_argument("--every", type=int, default=1, metavar="K",
                         help="only every K-th task, a quick sample across all groups (default: 1, all)")
@@ -36,21 +36,22 @@ def register(subparsers: Any) -> None:
 
 def _eval(args: argparse.Namespace) -> int:
     from agent.evalsuite.runner import render_table, run_suite, summarize
-    from agent.evalsuite.suite import GROUPS, SuiteError, load_suite
+    from agent.evalsuite.suite import SuiteError, load_suite
     from agent.translate import ModelNotFoundError
     from agent.translate.http import EndpointError
     from rsl.profile import ProfileError, load_profile
 
-    unknown = [g for g in args.group or [] if g not in GROUPS]
-    if unknown:
-        print(f"nrtrans eval: error: unknown group {', '.join(unknown)}; use one of {', '.join(GROUPS)}",
-              file=sys.stderr)
-        return EXIT_USAGE
     try:
         profile = load_profile(args.profile)
         tasks = list(load_suite(args.suite, profile))
     except (ProfileError, SuiteError) as exc:
         print(f"nrtrans eval: error: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    groups = list(dict.fromkeys(t.group for t in tasks))
+    unknown = [g for g in args.group or [] if g not in groups]
+    if unknown:
+        print(f"nrtrans eval: error: unknown group {', '.join(unknown)}; use one of {', '.join(groups)}",
+              file=sys.stderr)
         return EXIT_USAGE
     if args.group:
         tasks = [t for t in tasks if t.group in args.group]

@@ -7,7 +7,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from agent.evalsuite.suite import GROUPS, EvalTask, accepts
+from agent.evalsuite.suite import EvalTask, accepts
 from rsl.profile import Profile
 
 
@@ -20,10 +20,16 @@ class TaskOutcome:
     passes: int
     latency_ms: float
 
+    @property
+    def wrong_runs(self) -> bool:
+        """A verified program that is not what was asked: the robot would have moved wrongly."""
+        return self.verified and not self.accepted
+
     def to_dict(self) -> dict[str, Any]:
         return {"group": self.task.group, "task": self.task.task, "program": self.program,
                 "verified": self.verified, "accepted": self.accepted, "passes": self.passes,
-                "latency_ms": round(self.latency_ms, 1), "holdout": self.task.holdout}
+                "latency_ms": round(self.latency_ms, 1), "holdout": self.task.holdout,
+                "refuse": self.task.refuse}
 
 
 def run_suite(translator: Any, tasks: Sequence[EvalTask], profile: Profile,
@@ -56,9 +62,14 @@ def percentile(values: Sequence[float], fraction: float) -> float:
 
 
 def summarize(outcomes: Sequence[TaskOutcome]) -> dict[str, dict[str, float]]:
-    """Per group and `overall`: n, success, accuracy, mean passes, latency p50/p95 (ms)."""
+    """Per group (in the order they first appear) and `overall`.
+
+    Each row: n, success (verified), accuracy, wrong_runs (verified but not
+    what was asked), mean passes, latency p50/p95 (ms).
+    """
     table: dict[str, dict[str, float]] = {}
-    buckets = [(g, [o for o in outcomes if o.task.group == g]) for g in GROUPS]
+    groups = dict.fromkeys(o.task.group for o in outcomes)
+    buckets = [(g, [o for o in outcomes if o.task.group == g]) for g in groups]
     buckets.append(("overall", list(outcomes)))
     for name, group in buckets:
         if not group:
@@ -68,6 +79,7 @@ def summarize(outcomes: Sequence[TaskOutcome]) -> dict[str, dict[str, float]]:
             "n": len(group),
             "success": sum(o.verified for o in group) / len(group),
             "accuracy": sum(o.accepted for o in group) / len(group),
+            "wrong_runs": sum(o.wrong_runs for o in group) / len(group),
             "mean_passes": statistics.fmean(o.passes for o in group),
             "latency_p50_ms": percentile(latencies, 0.5),
             "latency_p95_ms": percentile(latencies, 0.95),
@@ -76,9 +88,11 @@ def summarize(outcomes: Sequence[TaskOutcome]) -> dict[str, dict[str, float]]:
 
 
 def render_table(table: dict[str, dict[str, float]]) -> str:
-    header = f"{'group':<12} {'n':>4} {'success':>8} {'accuracy':>9} {'passes':>7} {'p50 ms':>8} {'p95 ms':>8}"
+    header = (f"{'group':<14} {'n':>4} {'success':>8} {'accuracy':>9} {'wrong+ran':>10} {'passes':>7} "
+              f"{'p50 ms':>8} {'p95 ms':>8}")
     lines = [header, "-" * len(header)]
     for name, row in table.items():
-        lines.append(f"{name:<12} {int(row['n']):>4} {row['success']:>8.1%} {row['accuracy']:>9.1%} "
-                     f"{row['mean_passes']:>7.2f} {row['latency_p50_ms']:>8.0f} {row['latency_p95_ms']:>8.0f}")
+        lines.append(f"{name:<14} {int(row['n']):>4} {row['success']:>8.1%} {row['accuracy']:>9.1%} "
+                     f"{row['wrong_runs']:>10.1%} {row['mean_passes']:>7.2f} {row['latency_p50_ms']:>8.0f} "
+                     f"{row['latency_p95_ms']:>8.0f}")
     return "\n".join(lines)

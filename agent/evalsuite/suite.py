@@ -2,7 +2,12 @@
 
 A plan is accepted when it matches one of the task's accepted programs after
 consecutive moves of one kind are merged (`forward 1; forward 1;` is
-`forward 2;`), with every number within a tolerance.
+`forward 2;`), with every number within a tolerance. A task marked
+`refuse = true` is not a robot task: it is done right only when no plan
+comes back.
+
+A suite file may name its own groups in a top-level `groups = [...]`; the
+evaluation suite uses `GROUPS`.
 """
 
 from __future__ import annotations
@@ -28,6 +33,7 @@ class EvalTask:
     accept: tuple[str, ...]
     objects: tuple[str, ...] | None = None
     holdout: bool = False
+    refuse: bool = False
 
 
 class SuiteError(ValueError):
@@ -45,15 +51,19 @@ def load_suite(path: str | Path | None = None, profile: Profile | None = None) -
         data = tomllib.loads(source.read_text("utf-8"))
     except (OSError, tomllib.TOMLDecodeError) as exc:
         raise SuiteError(f"cannot load the evaluation suite {source}: {exc}") from exc
+    groups = tuple(str(g) for g in data.get("groups", GROUPS))
     tasks = []
     for index, raw in enumerate(data.get("task", []), start=1):
         group = str(raw.get("group", ""))
-        if group not in GROUPS:
-            raise SuiteError(f"{source}: task #{index} has group {group!r}; use one of {', '.join(GROUPS)}")
+        if group not in groups:
+            raise SuiteError(f"{source}: task #{index} has group {group!r}; use one of {', '.join(groups)}")
         objects = raw.get("objects")
         task = EvalTask(group=group, task=str(raw["task"]), accept=tuple(str(a) for a in raw["accept"]),
                         objects=None if objects is None else tuple(str(o) for o in objects),
-                        holdout=bool(raw.get("holdout", False)))
+                        holdout=bool(raw.get("holdout", False)), refuse=bool(raw.get("refuse", False)))
+        if task.refuse == bool(task.accept):
+            raise SuiteError(f"{source}: task #{index} ({task.task!r}) must either accept programs or be "
+                             "`refuse = true` with `accept = []`")
         if profile is not None:
             for program in task.accept:
                 result = compile_program(program, profile, task.objects)
@@ -66,9 +76,9 @@ def load_suite(path: str | Path | None = None, profile: Profile | None = None) -
 
 
 def accepts(task: EvalTask, plan: Plan | None, profile: Profile) -> bool:
-    """True when `plan` does what one of the task's accepted programs does."""
-    if plan is None:
-        return False
+    """True when `plan` does what one of the task's accepted programs does, or is None for a non-task."""
+    if plan is None or task.refuse:
+        return plan is None and task.refuse
     mergeable = _mergeable(profile)
     got = _merged(plan.commands, mergeable)
     for program in task.accept:
