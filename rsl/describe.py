@@ -62,8 +62,9 @@ def markdown_reference(profile: Profile) -> str:
         "",
         "Each statement is a lowercase command, its arguments separated by `,`, and `;`. "
         "Whitespace and newlines are free. Comments are `// to the end of the line` and `/* blocks */`. "
-        "Numbers are C-style decimals (`2`, `0.5`, `.5`, `1e-1`); amounts must be positive, "
-        "only `goto` coordinates may be zero or negative. Object names are C identifiers.",
+        "Numbers are C-style decimals (`2`, `0.5`, `.5`, `1e-1`), not C's hexadecimal `0x10` or octal `010`; "
+        "amounts must be positive, only `goto` coordinates may be zero or negative. "
+        "Object names are ASCII C identifiers (letters, digits and `_`).",
         "",
         "| statement | what it does | parameters | example |",
         "|---|---|---|---|",

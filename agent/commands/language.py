@@ -123,7 +123,8 @@ def _compile(args: argparse.Namespace) -> int:
     if not result.ok or result.plan is None:
         for diagnostic in result.diagnostics:
             print(diagnostic.render(), file=sys.stderr)
-        print(f"{args.file}: not compiled, {len(result.diagnostics)} errors", file=sys.stderr)
+        count = len(result.diagnostics)
+        print(f"{args.file}: not compiled, {count} error{'s' if count != 1 else ''}", file=sys.stderr)
         return EXIT_ERRORS
     emit = args.emit or ("plan" if args.output and args.output.endswith(".json") else "python")
     if emit == "python":
