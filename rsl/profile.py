@@ -157,6 +157,20 @@ class Convention:
 
 
 @dataclass(frozen=True)
+class Inability:
+    """Something people ask of robots that this one cannot do, so a request for it is refused
+    with the reason instead of being translated into the nearest skill it has."""
+
+    what: str  # e.g. "pick things up: it has no arm or gripper"
+    phrases: tuple[str, ...]  # lowercase words or phrases that ask for it, e.g. "pick up"
+
+    def asked_in(self, text: str) -> str | None:
+        """The phrase of `text` that asks for this, if any."""
+        lowered = text.lower()
+        return next((p for p in self.phrases if re.search(rf"\b{re.escape(p)}\b", lowered)), None)
+
+
+@dataclass(frozen=True)
 class Motion:
     max_linear_speed: float = 0.5
     max_angular_speed: float = 1.0
@@ -180,6 +194,7 @@ class Profile:
     ros: dict[str, Any]
     conventions: tuple[Convention, ...]
     digest: str = field(repr=False)
+    cannot: tuple[Inability, ...] = ()
     source: str = field(repr=False, default="")
 
     def skill(self, keyword: str) -> Skill | None:
@@ -188,6 +203,14 @@ class Profile:
     @property
     def keywords(self) -> tuple[str, ...]:
         return tuple(s.keyword for s in self.skills)
+
+    def inability(self, text: str) -> tuple[Inability, str] | None:
+        """What of this robot's inabilities `text` asks for, with the phrase that asks."""
+        for inability in self.cannot:
+            phrase = inability.asked_in(text)
+            if phrase is not None:
+                return inability, phrase
+        return None
 
     def bound_to(self, primitive: str) -> Skill | None:
         """The first skill bound to a robot primitive, to name it in advice."""
@@ -271,6 +294,17 @@ def _build(data: dict[str, Any], text: str, source: str) -> Profile:
                    task=str(c.get("task", "")), program=str(c.get("program", "")))
         for c in data.get("conventions", [])
     )
+    cannot = []
+    for index, raw in enumerate(data.get("cannot", []), start=1):
+        what, phrases = raw.get("what"), raw.get("phrases")
+        if (not isinstance(what, str) or not what or not isinstance(phrases, list) or not phrases
+                or not all(isinstance(p, str) and p.strip() for p in phrases)):
+            raise fail(f"[[cannot]] #{index} needs `what` (a sentence) and `phrases` (a list of words)")
+        for phrase in phrases:
+            for skill in skills:
+                if phrase.lower() in (skill.keyword, *skill.aliases):
+                    raise fail(f"[[cannot]] phrase {phrase!r} is a word for the skill `{skill.keyword}`")
+        cannot.append(Inability(what=what, phrases=tuple(p.strip().lower() for p in phrases)))
     limits = data.get("limits", {})
     max_statements = int(limits.get("max_statements", 64))
     if max_statements < 1:
@@ -288,6 +322,7 @@ def _build(data: dict[str, Any], text: str, source: str) -> Profile:
         conventions=conventions,
         digest=hashlib.sha256(text.encode("utf-8")).hexdigest(),
         source=source,
+        cannot=tuple(cannot),
     )
 
 
