@@ -47,6 +47,7 @@ class RobotSpecificDrivers:
 
     def __init__(self) -> None:
         from rclpy.qos import QoSProfile, ReliabilityPolicy
+        from sensor_msgs.msg import JointState
         from std_msgs.msg import Float64
         from std_srvs.srv import Trigger
         from trajectory_msgs.msg import JointTrajectory
@@ -62,10 +63,22 @@ class RobotSpecificDrivers:
         node.create_subscription(JointTrajectory, ARM_TOPIC, self._on_trajectory, reliable)
         node.create_subscription(Float64, LIGHTS_TOPIC, self._on_lights, reliable)
         node.create_service(Trigger, DOCK_SERVICE, self._on_dock)
+        # Off until a test turns it on: then the arm reports its joint, as a real arm does,
+        # moving to each trajectory's end point in one step.
+        self.report_arm = False
+        self.arm_position = 0.0
+        self._joint_state = JointState
+        self._joints = node.create_publisher(JointState, "/joint_states", reliable)
+        node.create_timer(0.05, self._publish_arm)
 
     def _on_trajectory(self, msg: Any) -> None:
         self.trajectories.append(msg)
+        self.arm_position = float(msg.points[-1].positions[0])
         self.received.set()
+
+    def _publish_arm(self) -> None:
+        if self.report_arm:
+            self._joints.publish(self._joint_state(name=[ARM_JOINT], position=[self.arm_position]))
 
     def _on_lights(self, msg: Any) -> None:
         self.lights.append(msg.data)
@@ -127,6 +140,24 @@ def test_skills_added_by_profile_alone_reach_the_robot_with_their_values(
     assert "arrival not checked, joint_states does not report arm_shoulder_joint" in wave.reason
     assert dock.reason == "/dock: docked, charging"
     assert forward.ok and result.final_state is not None and result.final_state.pose.x == pytest.approx(0.1, abs=0.02)
+
+
+def test_a_trajectory_to_a_joint_the_robot_reports_waits_for_it_to_arrive(
+        renamed_bridge: tuple[Bridge, Path], probe: Probe, drivers: RobotSpecificDrivers) -> None:
+    profile = extended_profile()
+    drivers.report_arm = True
+    try:
+        with Ros2Robot(profile, connect_timeout=30.0) as robot:
+            deadline = time.monotonic() + 10.0
+            while ARM_JOINT not in robot._link.joints()[0]:
+                assert time.monotonic() < deadline, "the arm's joint state never arrived"
+                time.sleep(0.02)
+            outcome = robot.wave(1.2, cancel=CancelToken())  # type: ignore[attr-defined]
+            assert robot._link.joints()[0][ARM_JOINT] == pytest.approx(1.2)
+    finally:
+        drivers.report_arm = False
+    assert outcome.ok and outcome.reason == ""  # arrival was checked, nothing to note
+    assert list(drivers.trajectories[-1].points[0].positions) == [pytest.approx(1.2)]
 
 
 def test_a_service_that_refuses_fails_the_step_with_its_reason(
