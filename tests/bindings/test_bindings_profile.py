@@ -3,6 +3,7 @@ below the profile that says what a skill does."""
 
 from __future__ import annotations
 
+import json
 import os
 import re
 import subprocess
@@ -65,6 +66,11 @@ def test_new_skills_parse_and_appear_in_grammar_prompt_and_docs(tmp_path: Path) 
             "/arm_controller/joint_trajectory | `wave 0.8;` |") in docs.stdout
     assert "calls the std_srvs/srv/Trigger service /dock" in docs.stdout
     assert "publishes std_msgs/msg/Float64 on /lights/level" in docs.stdout
+    shown = cli("profile", "show", "--format", "json", "--profile", str(path))
+    bindings = {s["keyword"]: s["binding"] for s in json.loads(shown.stdout)["skills"]}
+    assert bindings["dock"]["form"] == "ros" and bindings["dock"]["name"] == "/dock"
+    assert bindings["backward"] == {"form": "primitive", "name": "drive", "sign": -1.0,
+                                    "does": "primitive `drive`, sign -1"}
 
 
 BASE = default_profile_path().read_text(encoding="utf-8")
