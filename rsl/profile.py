@@ -429,10 +429,10 @@ def _ros_binding(raw: dict[str, Any], params: tuple[Param, ...], fail: Any) -> R
             return value if isinstance(value, bool) else float(value)
         raise fail(f"{what} must be a parameter's name or a constant, got {value!r}")
 
-    def all_used(sources: list[Source]) -> None:
+    def all_used(sources: list[Source], into: str) -> None:
         unused = names - {s for s in sources if isinstance(s, str)}
         if unused:
-            raise fail(f"does not send the parameter(s) {', '.join(sorted(unused))}; map each to a field")
+            raise fail(f"does not send the parameter(s) {', '.join(sorted(unused))}; {into}")
 
     if kind == "topic":
         message_type = raw.get("type")
@@ -446,16 +446,16 @@ def _ros_binding(raw: dict[str, Any], params: tuple[Param, ...], fail: Any) -> R
             if not _FIELD_PATH.match(path):
                 raise fail(f"field {path!r} must be a field path such as \"data\" or \"linear.x\"")
             fields.append((path, source(value, f"field `{path}`")))
-        all_used([v for _, v in fields])
+        all_used([v for _, v in fields], "map each to a message field")
         return RosBinding(kind=kind, name=name, message_type=message_type, fields=tuple(fields))
     if kind == "trigger":
-        all_used([])
+        all_used([], "a Trigger request carries none, so declare params = []")
         return RosBinding(kind=kind, name=name)
     if kind == "setbool":
         data = raw.get("data")
         if not isinstance(data, bool):
             raise fail("`data` must be true or false, the SetBool request's value")
-        all_used([])
+        all_used([], "a SetBool request carries only its constant `data`, so declare params = []")
         return RosBinding(kind=kind, name=name, data=data)
     joints = raw.get("joints")
     positions = raw.get("positions")
@@ -465,10 +465,10 @@ def _ros_binding(raw: dict[str, Any], params: tuple[Param, ...], fail: Any) -> R
     if not isinstance(positions, list) or len(positions) != len(joints):
         raise fail(f"`positions` must give one position per joint ({len(joints)}), got {positions!r}")
     sources = [source(p, f"the position of `{j}`") for j, p in zip(joints, positions, strict=True)]
-    all_used(sources)
-    for s, p in ((s, next((p for p in params if p.name == s), None)) for s in sources):
-        if p is not None and p.kind != "number":
-            raise fail(f"the joint position {s!r} must be a number parameter")
+    all_used(sources, "give each as a joint's position")
+    objects = [p.name for p in params if p.kind == "object"]
+    if objects:
+        raise fail(f"a joint position must be a number, and {', '.join(objects)} is an object")
     duration = raw.get("duration", 1.0)
     if isinstance(duration, bool) or not isinstance(duration, int | float) or duration < 0:
         raise fail(f"`duration` must be seconds >= 0 (the trajectory point's time_from_start), got {duration!r}")
