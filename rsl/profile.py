@@ -320,10 +320,28 @@ def _build(data: dict[str, Any], text: str, source: str) -> Profile:
         head=head,
         ros=dict(data.get("ros", {})),
         conventions=conventions,
-        digest=hashlib.sha256(text.encode("utf-8")).hexdigest(),
+        digest=hashlib.sha256(_without_bindings(text).encode("utf-8")).hexdigest(),
         source=source,
         cannot=tuple(cannot),
     )
+
+
+def _without_bindings(text: str) -> str:
+    """The profile's text without its bindings: what the digest covers.
+
+    The digest says which language an adapter was trained on (its card keeps
+    it). A binding changes how the robot does a skill, not how the skill is
+    written or what it means, so rebinding a skill keeps the adapter.
+    """
+    kept: list[str] = []
+    in_binding = False
+    for line in text.splitlines(keepends=True):
+        stripped = line.strip()
+        if stripped.startswith("[") or not stripped:
+            in_binding = stripped.replace(" ", "") == "[skills.binding]"
+        if not in_binding and not re.match(r"binding\s*=", stripped):
+            kept.append(line)
+    return "".join(kept)
 
 
 def _pair(value: Any, where: str, fail: Any) -> tuple[float, float]:

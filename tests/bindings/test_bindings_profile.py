@@ -138,3 +138,16 @@ def test_the_shipped_profiles_load() -> None:
     for path in sorted((REPO / "rsl" / "profiles").glob("*.toml")):
         loaded = load_profile(path)
         assert all(s.binding is not None for s in loaded.skills), path
+
+
+def test_rebinding_a_skill_keeps_the_adapter_renaming_one_does_not(profile) -> None:
+    """The digest an adapter's card pins covers the language, not how the robot does it."""
+    from agent.adapter.card import card_path, read_card
+    from agent.adapter.prompt import DEFAULT_ADAPTER
+
+    assert profile.digest == read_card(card_path(DEFAULT_ADAPTER)).profile_sha256
+    rebound = BASE.replace(FORWARD, '[skills.binding]\nros = "topic"\ntopic = "/creep"\n'
+                                    'type = "std_msgs/msg/Float64"\nfields = { data = "distance" }', 1)
+    assert parse_profile(rebound).skill("forward").binding.kind == "topic"
+    assert parse_profile(rebound).digest == profile.digest
+    assert parse_profile(renamed_profile_text()).digest != profile.digest
