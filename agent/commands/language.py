@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import sys
 from pathlib import Path
@@ -174,7 +175,10 @@ def _profile_show(args: argparse.Namespace) -> int:
             "skills": [{"keyword": s.keyword, "signature": s.signature, "description": s.description,
                         "example": s.example,
                         "params": [{"name": p.name, "kind": p.kind, "unit": p.unit, "min": p.min,
-                                    "max": p.max, "axis": p.axis} for p in s.params]}
+                                    "max": p.max, "axis": p.axis} for p in s.params],
+                        "binding": None if s.binding is None else {
+                            "form": "primitive" if s.primitive is not None else "ros", **dataclasses.asdict(s.binding),
+                            "does": s.binding.describe()}}
                        for s in profile.skills],
             "conventions": [c.__dict__ for c in profile.conventions],
         }, indent=2))

@@ -173,6 +173,11 @@ class Translator:
         if not normalized:
             return TranslationResult(task=task, program="", verified=False, passes=0, attempts=(), plan=None,
                                      model=self.model_name, timings_ms={**timings, "total": 0.0})
+        beyond = self._beyond_robot(normalized)
+        if beyond is not None:
+            return TranslationResult(task=task, program="", verified=False, passes=0,
+                                     attempts=(Attempt(program="", diagnostics=(beyond,)),), plan=None,
+                                     model=self.model_name, timings_ms={**timings, "total": 0.0})
         clauses = (split_clauses(normalized, self.profile) if self.options.split_clauses
                    else [Clause(text=normalized)])
         states = [_ClauseState(c) for c in clauses]
@@ -340,6 +345,20 @@ class Translator:
             if len(words) == 2:
                 names.append("_".join(words))
         return tuple(dict.fromkeys(names)) or None
+
+    def _beyond_robot(self, text: str) -> Diagnostic | None:
+        """A request for what the profile says this robot cannot do: refused before the model
+        can turn it into the nearest skill the robot has ("pick up the cup" into `approach cup;`)."""
+        found = self.profile.inability(text)
+        if found is None:
+            return None
+        inability, phrase = found
+        can = ", ".join(f"`{s.keyword}`" for s in self.profile.skills)
+        return Diagnostic(
+            code=Code.NOT_A_TASK, line=1, column=text.find(phrase) + 1, token=phrase,
+            message=f"'{text}' asks the {self.profile.name} robot to {phrase}, and it cannot {inability.what}. "
+                    f"Nothing was run. It can: {can}",
+            source_line=text)
 
     def _not_a_task(self, state: _ClauseState) -> Diagnostic:
         if state.refused:
