@@ -231,13 +231,6 @@ def runtime_dir() -> Path:
     return Path("/run/nrtrans")
 
 
-def default_socket_path() -> Path:
-    """Where clients look when no `--socket` is given: `$NRTRANS_SOCKET`, else the daemon's default."""
-    if os.environ.get("NRTRANS_SOCKET"):
-        return Path(os.environ["NRTRANS_SOCKET"])
-    return runtime_dir() / "nrtrans.sock"
-
-
 def config_path_from_env(flag: str | None) -> Path | None:
     chosen = flag or os.environ.get("NRTRANS_CONFIG")
     return Path(chosen).expanduser() if chosen else None
