@@ -212,7 +212,8 @@ def describe_event(event: dict[str, Any]) -> str:
     name = event["event"]
     prefix = f"[{event['task']}]" if event.get("task") else "[daemon]"
     if name == "queued":
-        detail = f"position {event['position']} in the queue"
+        ahead = event["position"]
+        detail = "next in line" if ahead == 0 else f"behind {ahead} other task{'s' if ahead > 1 else ''}"
     elif name in ("heard", "translating"):
         detail = repr(event["text"])
     elif name == "attempt":
@@ -234,9 +235,17 @@ def describe_event(event: dict[str, Any]) -> str:
             detail += f" ({outcome['reason']})"
     elif name == "done":
         pose = (event.get("state") or {}).get("pose")
-        detail = f"pose x={pose['x']:.2f} y={pose['y']:.2f} heading={pose['heading']:.2f}" if pose else ""
+        detail = (
+            f"pose x={_number(pose['x'])} y={_number(pose['y'])} heading={_number(pose['heading'])}" if pose else ""
+        )
     elif name == "speech":
         detail = str(event.get("state", ""))
     else:
         detail = str(event.get("reason", ""))
     return f"{prefix} {name} {detail}".rstrip()
+
+
+def _number(value: float) -> str:
+    """Two decimals, without the "-0.00" of a value that rounds to zero from below."""
+    text = f"{value:.2f}"
+    return "0.00" if text == "-0.00" else text

@@ -198,8 +198,12 @@ def _estop(args: argparse.Namespace) -> int:
 
 def _reset(args: argparse.Namespace) -> int:
     def action(client: Any) -> int:
+        latched = client.status().get("estop")
         client.reset()
-        print("emergency stop released: tasks are accepted again")
+        if latched:
+            print(f"emergency stop released ({latched}): tasks are accepted again")
+        else:
+            print("no emergency stop was latched: nothing to release; tasks are accepted")
         return 0
 
     return _call(args, action)

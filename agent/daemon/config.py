@@ -140,6 +140,13 @@ class RobotConfig:
     realtime_factor: float = field(
         default=1.0, metadata=_doc("Simulator speed: 1.0 runs in real time, 0 as fast as possible.", min=0.0)
     )
+    record: str = field(
+        default="",
+        metadata=_doc(
+            "Directory for pictures of each task's run, in a folder named after the task: `trajectory.png`, "
+            "and with the simulator a camera snapshot per step and `run.gif`. Empty: no pictures."
+        ),
+    )
 
 
 @dataclass(frozen=True)
