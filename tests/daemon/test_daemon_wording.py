@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import io
 import os
 import subprocess
 from pathlib import Path
+
+import pytest
 
 from agent.client import describe_event
 from tests.daemon.conftest import NRTRANS, Daemon, follow
@@ -44,3 +47,13 @@ def test_reset_the_serve_log_and_the_last_line(workdir: Path) -> None:
     assert log.count("ready:") == 1, log  # once when started, not again after every task
     assert "emergency stop released" in log
     assert log.rstrip().splitlines()[-1].endswith("stopped (exit status 0)"), log
+
+
+def test_a_program_from_standard_input_is_called_so(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from agent.cli import main
+
+    monkeypatch.setattr("sys.stdin", io.StringIO("forward 1;\n"))
+    assert main(["check", "-"]) == 0
+    assert capsys.readouterr().err.startswith("standard input: ok")
