@@ -56,6 +56,7 @@ class Recorder:
         self.snapshots: list[Path] = []
         self._frames: list[Any] = []
         self._caption = "start"
+        self._font: Any = None
         self._ticks = 0
         self._next_frame = 0.0
         self._period = GIF_PERIOD
@@ -110,15 +111,16 @@ class Recorder:
         """The frame with the step it shows written across its bottom."""
         from PIL import Image, ImageDraw, ImageFont
 
+        if self._font is None:
+            try:
+                self._font = ImageFont.load_default(size=13)
+            except (TypeError, OSError):  # Pillow without FreeType: the small bitmap font
+                self._font = ImageFont.load_default()
         image = Image.fromarray(frame)
         draw = ImageDraw.Draw(image)
-        try:
-            font: Any = ImageFont.load_default(size=13)
-        except (TypeError, OSError):  # Pillow without FreeType: the small bitmap font
-            font = ImageFont.load_default()
         height = image.height
         draw.rectangle((0, height - 20, image.width, height), fill=(0, 0, 0))
-        draw.text((4, height - 18), self._caption, fill=(255, 255, 255), font=font)
+        draw.text((4, height - 18), self._caption, fill=(255, 255, 255), font=self._font)
         return image
 
     def finish(self, result: ExecutionResult | None = None, title: str = "") -> list[Path]:

@@ -437,14 +437,13 @@ class Service:
         assert self._execute_plan is not None, "load() sets the executor"
         recorder = self._recorder(task)
         on_event = on_step if recorder is None else _both(recorder.on_event, on_step)
-        result = self._execute_plan(plan, self.robot, self.profile, cancel=task.cancel, on_event=on_event)
+        result = None
+        try:
+            result = self._execute_plan(plan, self.robot, self.profile, cancel=task.cancel, on_event=on_event)
+        finally:
+            if recorder is not None:
+                _save_pictures(task, recorder, result)
         task.mark("total_ms", start)
-        if recorder is not None:
-            try:
-                pictures = recorder.finish(result, title=task.text or "RSL program")
-                log.info("task %s: %d picture(s) in %s", task.id, len(pictures), pictures[0].parent)
-            except Exception as exc:
-                log.warning("task %s: the pictures were not saved: %s", task.id, exc)
         status = getattr(result.status, "value", result.status)
         final_state = result.final_state.to_dict() if result.final_state is not None else None
         if status == "done":
@@ -576,6 +575,14 @@ def _last_reason(result: Any) -> str:
         if getattr(outcome, "reason", ""):
             return str(outcome.reason)
     return ""
+
+
+def _save_pictures(task: Task, recorder: Any, result: Any) -> None:
+    try:
+        pictures = recorder.finish(result, title=task.text or "RSL program")
+        log.info("task %s: %d picture(s) in %s", task.id, len(pictures), pictures[0].parent)
+    except Exception as exc:
+        log.warning("task %s: the pictures were not saved: %s", task.id, exc)
 
 
 def _both(pictures: Callable[[Any], None], on_step: Callable[[Any], None]) -> Callable[[Any], None]:
