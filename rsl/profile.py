@@ -266,7 +266,7 @@ def _build(data: dict[str, Any], text: str, source: str) -> Profile:
     workspace = {axis: _pair(data.get("workspace", {}).get(axis, (-10.0, 10.0)), f"workspace.{axis}", fail)
                  for axis in ("x", "y")}
     head = {joint: _pair(data.get("head", {}).get(joint, default), f"head.{joint}", fail)
-            for joint, default in (("pan", (-1.57, 1.57)), ("tilt", (-0.6, 0.9)))}
+            for joint, default in (("pan", (-1.5708, 1.5708)), ("tilt", (-0.6, 0.9)))}
 
     skills: list[Skill] = []
     seen: set[str] = set()

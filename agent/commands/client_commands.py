@@ -13,13 +13,18 @@ EXIT_NOT_DONE = 1
 EXIT_NO_DAEMON = 2
 EXIT_REFUSED = 3
 
-_SOCKET_HELP = "daemon socket (default: $NRTRANS_SOCKET, else the daemon's default under the runtime dir)"
+_SOCKET_HELP = (
+    "daemon socket (default: $NRTRANS_SOCKET, else api.socket in the config file, "
+    "else nrtrans.sock in the runtime dir, as `nrtrans serve` picks it)"
+)
+_CONFIG_HELP = "the daemon's config file, read for api.socket (default: $NRTRANS_CONFIG)"
 
 
 def register(subparsers: Any) -> None:
     def add(name: str, help: str, description: str, func: Any) -> argparse.ArgumentParser:
         parser = subparsers.add_parser(name, help=help, description=description)
         parser.add_argument("--socket", metavar="PATH", help=_SOCKET_HELP)
+        parser.add_argument("--config", metavar="FILE", help=_CONFIG_HELP)
         parser.add_argument("--json", action="store_true", help="print the raw JSON frames")
         parser.set_defaults(func=func)
         return parser
@@ -100,7 +105,7 @@ def register(subparsers: Any) -> None:
 def _connect(args: argparse.Namespace) -> Any:
     from agent.client import Client
 
-    return Client.connect(args.socket, timeout=None)
+    return Client.connect(args.socket, timeout=None, config_file=args.config)
 
 
 def _call(args: argparse.Namespace, action: Any) -> int:
@@ -193,8 +198,12 @@ def _estop(args: argparse.Namespace) -> int:
 
 def _reset(args: argparse.Namespace) -> int:
     def action(client: Any) -> int:
+        latched = client.status().get("estop")
         client.reset()
-        print("emergency stop released: tasks are accepted again")
+        if latched:
+            print(f"emergency stop released ({latched}): tasks are accepted again")
+        else:
+            print("no emergency stop was latched: nothing to release; tasks are accepted")
         return 0
 
     return _call(args, action)

@@ -106,8 +106,9 @@ def _check(args: argparse.Namespace) -> int:
         for diagnostic in result.diagnostics:
             print(diagnostic.render())
         count = len(result.diagnostics)
-        summary = (f"{args.file}: ok, {len(result.plan or ())} statements" if result.ok
-                   else f"{args.file}: {count} error{'s' if count != 1 else ''}")
+        name = "standard input" if args.file == "-" else args.file
+        summary = (f"{name}: ok, {len(result.plan or ())} statements" if result.ok
+                   else f"{name}: {count} error{'s' if count != 1 else ''}")
         print(summary, file=sys.stderr)
     return EXIT_OK if result.ok else EXIT_ERRORS
 

@@ -29,7 +29,9 @@ def serve(config: Config, *, config_file: Path | None = None, reload: Callable[[
     started = time.monotonic()
 
     def status(text: str) -> None:
-        log.info("%s", text)
+        # The idle line is logged once, when the daemon is ready, not again after every task.
+        if text != service.idle_status():
+            log.info("%s", text)
         notifier.status(text)
 
     service = Service(config, on_status=status)
@@ -52,10 +54,12 @@ def serve(config: Config, *, config_file: Path | None = None, reload: Callable[[
         # Still inside the model after the grace period, with every record already final:
         # leave now rather than finalize the interpreter under a running native thread.
         log.warning("the translator did not finish within the grace period; exiting without waiting for it")
+        log.info("stopped (exit status %d)", code)
         logging.shutdown()
         sys.stdout.flush()
         sys.stderr.flush()
         os._exit(code)
+    log.info("stopped (exit status %d)", code)
     return code
 
 
@@ -96,7 +100,7 @@ async def _serve(
 
     ready_s = time.monotonic() - started
     notifier.ready(service.idle_status())
-    log.info("ready in %.2f s: %s", ready_s, service.idle_status())
+    log.info("%s (started in %.2f s)", service.idle_status(), ready_s)
     pinger = asyncio.create_task(_watchdog(service, notifier))
     try:
         await stop.wait()

@@ -14,6 +14,7 @@ import threading
 import time
 from collections import OrderedDict
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 from agent.daemon.audit import AuditError, AuditLog
@@ -224,6 +225,7 @@ class Service:
             was_latched = self._estop_reason is not None
             self._estop_reason = None
         if was_latched:
+            log.info("emergency stop released")
             self.events.publish("reset", None)
             self.on_status(self.idle_status())
         return was_latched
@@ -433,7 +435,14 @@ class Service:
             )
 
         assert self._execute_plan is not None, "load() sets the executor"
-        result = self._execute_plan(plan, self.robot, self.profile, cancel=task.cancel, on_event=on_step)
+        recorder = self._recorder(task)
+        on_event = on_step if recorder is None else _both(recorder.on_event, on_step)
+        result = None
+        try:
+            result = self._execute_plan(plan, self.robot, self.profile, cancel=task.cancel, on_event=on_event)
+        finally:
+            if recorder is not None:
+                _save_pictures(task, recorder, result)
         task.mark("total_ms", start)
         status = getattr(result.status, "value", result.status)
         final_state = result.final_state.to_dict() if result.final_state is not None else None
@@ -445,6 +454,18 @@ class Service:
             self._finish(task, TaskState.FAILED, _last_reason(result) or "a step failed", robot_state=final_state)
 
     # -- helpers ---------------------------------------------------------------------------
+
+    def _recorder(self, task: Task) -> Any:
+        """Pictures of this task's run when [robot] record names a directory; they never fail a task."""
+        if not self.config.robot.record:
+            return None
+        try:
+            from agent.record import Recorder
+
+            return Recorder(Path(self.config.robot.record).expanduser() / task.id, self.robot, gif=True)
+        except Exception as exc:
+            log.warning("task %s: no pictures: %s", task.id, exc)
+            return None
 
     def _halted(self, task: Task) -> bool:
         """Finish `task` as cancelled if it was cancelled or an emergency stop is latched."""
@@ -554,6 +575,25 @@ def _last_reason(result: Any) -> str:
         if getattr(outcome, "reason", ""):
             return str(outcome.reason)
     return ""
+
+
+def _save_pictures(task: Task, recorder: Any, result: Any) -> None:
+    try:
+        pictures = recorder.finish(result, title=task.text or "RSL program")
+        log.info("task %s: %d picture(s) in %s", task.id, len(pictures), pictures[0].parent)
+    except Exception as exc:
+        log.warning("task %s: the pictures were not saved: %s", task.id, exc)
+
+
+def _both(pictures: Callable[[Any], None], on_step: Callable[[Any], None]) -> Callable[[Any], None]:
+    def call(event: Any) -> None:
+        try:
+            pictures(event)
+        except Exception as exc:  # a picture is never worth a step
+            log.warning("a picture of step %s was not saved: %s", getattr(event, "index", "?"), exc)
+        on_step(event)
+
+    return call
 
 
 def _quietly(action: Callable[[], Any]) -> None:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import difflib
 import itertools
+import logging
 import re
 import threading
 import time
@@ -39,6 +40,9 @@ from rsl.diagnostics import Code, Diagnostic
 from rsl.plan import Quantity, format_number
 from rsl.profile import Convention, Profile
 from rsl.syntax import NO_PROGRAM
+
+# What the loop does, for a person following along (`nrtrans translate -v`, or log_level = "debug").
+progress = logging.getLogger("nrtrans.translate")
 
 MAX_TOKENS = 160
 # One clause rarely needs more; a square is 8 statements.
@@ -181,6 +185,8 @@ class Translator:
         clauses = (split_clauses(normalized, self.profile) if self.options.split_clauses
                    else [Clause(text=normalized)])
         states = [_ClauseState(c) for c in clauses]
+        progress.debug("task %r, normalized %r: %d clause(s): %s", task, normalized, len(clauses),
+                       " | ".join(repr(c.text) for c in clauses))
         for state in states:
             state.objects = self._task_objects(state.clause.text)
             if self.options.narrow and self.options.narrow_skills:
@@ -196,6 +202,9 @@ class Translator:
                 timings["generate"] += generation.generate_ms
                 state.program = _tidy(generation.text)
                 state.refused = self.options.refusal and state.program == NO_PROGRAM + "\n"
+                progress.debug("pass %d, clause %r -> %r (prompt %.0f ms, generation %.0f ms)", len(attempts) + 1,
+                               state.clause.text, state.program.strip(), generation.prompt_ms,
+                               generation.generate_ms)
                 if self.options.refuse_unclear and not attempts and not _reads_as_task(generation, self.profile):
                     state.unclear = (generation.first_piece, generation.first_probability or 0.0)
             program = _assemble(states)
@@ -205,6 +214,9 @@ class Translator:
             unclear = [self._not_a_task(state) for state in states if state.unclear is not None or state.refused]
             attempt = Attempt(program=program, diagnostics=(*unclear, *result.diagnostics))
             attempts.append(attempt)
+            progress.debug("pass %d: %s", len(attempts), "verified" if attempt.ok else
+                           f"{len(attempt.diagnostics)} problem(s): " + "; ".join(
+                               f"line {d.line}: {d.message}" for d in attempt.diagnostics))
             if on_attempt is not None:
                 on_attempt(attempt)
             if unclear or result.ok:
@@ -215,6 +227,9 @@ class Translator:
         assert result is not None
         timings["total"] = (time.perf_counter() - started) * 1000
         verified = attempts[-1].ok
+        progress.debug("%s after %d pass(es) in %.0f ms: prompt %.0f ms, generation %.0f ms, compile %.1f ms",
+                       "verified" if verified else "NOT verified", len(attempts), timings["total"],
+                       timings["prompt"], timings["generate"], timings["compile"])
         return TranslationResult(task=task, program=attempts[-1].program, verified=verified,
                                  passes=len(attempts), attempts=tuple(attempts),
                                  plan=result.plan if verified else None, model=self.model_name,
