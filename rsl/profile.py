@@ -10,6 +10,7 @@ topic, service or joint trajectory (docs/skills.md).
 from __future__ import annotations
 
 import hashlib
+import json
 import keyword as python_keyword
 import re
 import tomllib
@@ -251,10 +252,10 @@ def parse_profile(text: str, source: str = "<profile>") -> Profile:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ProfileError(f"{source}: not valid TOML: {exc}") from exc
-    return _build(data, text, source)
+    return _build(data, source)
 
 
-def _build(data: dict[str, Any], text: str, source: str) -> Profile:
+def _build(data: dict[str, Any], source: str) -> Profile:
     def fail(message: str) -> ProfileError:
         return ProfileError(f"{source}: {message}")
 
@@ -320,28 +321,32 @@ def _build(data: dict[str, Any], text: str, source: str) -> Profile:
         head=head,
         ros=dict(data.get("ros", {})),
         conventions=conventions,
-        digest=hashlib.sha256(_without_bindings(text).encode("utf-8")).hexdigest(),
+        digest=_language_digest(data),
         source=source,
         cannot=tuple(cannot),
     )
 
 
-def _without_bindings(text: str) -> str:
-    """The profile's text without its bindings: what the digest covers.
+# What a skill's statement is and means; bindings, spoken wording and the
+# like say how the robot does it or tells it, not what the adapter learned.
+_LANGUAGE_KEYS = ("keyword", "description", "example", "aliases", "opposite", "params")
 
-    The digest says which language an adapter was trained on (its card keeps
-    it). A binding changes how the robot does a skill, not how the skill is
-    written or what it means, so rebinding a skill keeps the adapter.
+
+def _language_digest(data: dict[str, Any]) -> str:
+    """The digest of the language a profile defines: what an adapter's card pins.
+
+    It covers each skill's statement and meaning, the conventions, the
+    workspace and the statement limit: the things the prompt and the training
+    data are made of. Rebinding a skill, rewording how it is explained or
+    changing a joint limit keeps the adapter; renaming a skill does not.
     """
-    kept: list[str] = []
-    in_binding = False
-    for line in text.splitlines(keepends=True):
-        stripped = line.strip()
-        if stripped.startswith("[") or not stripped:
-            in_binding = stripped.replace(" ", "") == "[skills.binding]"
-        if not in_binding and not re.match(r"binding\s*=", stripped):
-            kept.append(line)
-    return "".join(kept)
+    language = {
+        "skills": [{key: skill.get(key) for key in _LANGUAGE_KEYS} for skill in data.get("skills", [])],
+        "conventions": data.get("conventions", []),
+        "workspace": data.get("workspace", {}),
+        "limits": data.get("limits", {}),
+    }
+    return hashlib.sha256(json.dumps(language, sort_keys=True).encode("utf-8")).hexdigest()
 
 
 def _pair(value: Any, where: str, fail: Any) -> tuple[float, float]:

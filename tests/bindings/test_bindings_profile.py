@@ -151,3 +151,12 @@ def test_rebinding_a_skill_keeps_the_adapter_renaming_one_does_not(profile) -> N
     assert parse_profile(rebound).skill("forward").binding.kind == "topic"
     assert parse_profile(rebound).digest == profile.digest
     assert parse_profile(renamed_profile_text()).digest != profile.digest
+
+
+def test_the_digest_covers_the_language_not_limits_or_wording(profile) -> None:
+    """A joint limit or a key the language does not read keeps the adapter; a convention's program does not."""
+    limited = BASE.replace("pan = [-1.5708, 1.5708]", "pan = [-1.2, 1.2]", 1)
+    assert parse_profile(limited).head["pan"] == (-1.2, 1.2)
+    assert parse_profile(limited).digest == profile.digest
+    reconvened = BASE.replace('program = "forward 0.5;"', 'program = "forward 0.6;"', 1)
+    assert parse_profile(reconvened).digest != profile.digest
