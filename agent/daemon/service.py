@@ -369,7 +369,16 @@ class Service:
             task.attempts.append(entry)
             self.events.publish("attempt", task.id, **entry)
 
-        result = self.translator.translate(task.text, known_objects=known, on_attempt=on_attempt)
+        from agent.translate.engine import GenerationCancelled
+
+        try:
+            result = self.translator.translate(task.text, known_objects=known, on_attempt=on_attempt,
+                                               cancel=task.cancel)
+        except GenerationCancelled:
+            # Cut off mid-generation: a cancel or an estop need not wait for the translation to end.
+            task.mark("translate_ms", start)
+            self._finish(task, TaskState.CANCELLED, task.cancel.reason)
+            return None
         task.mark("translate_ms", start)
         task.model = getattr(result, "model", None)
         for name, value in (getattr(result, "timings_ms", None) or {}).items():
