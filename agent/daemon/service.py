@@ -19,6 +19,7 @@ from typing import Any
 from agent.daemon.audit import AuditError, AuditLog
 from agent.daemon.config import Config
 from agent.daemon.events import EventBus
+from agent.daemon.health import describe
 from agent.daemon.protocol import ProtocolError
 from agent.daemon.tasks import Busy, Peer, Task, TaskQueue, TaskState
 
@@ -268,8 +269,13 @@ class Service:
             "robot": robot,
             "audit": {"ok": self.audit._file is not None, "path": str(self.audit.path)},
             "speech": speech,
-            "estop": {"ok": self._estop_reason is None, "latched": self._estop_reason is not None},
+            "estop": {
+                "ok": self._estop_reason is None,
+                "latched": self._estop_reason is not None,
+                "reason": self._estop_reason,
+            },
         }
+        describe(components, backend=self.config.robot.backend, speech_problem=self.speech_problem)
         # Speech is optional: the daemon is healthy without a microphone.
         healthy = all(components[k]["ok"] for k in ("worker", "translator", "robot", "audit"))
         return healthy, components
