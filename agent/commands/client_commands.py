@@ -215,13 +215,26 @@ def _health(args: argparse.Namespace) -> int:
         if args.json:
             print(json.dumps(reply, indent=2))
         else:
-            print("healthy" if reply["healthy"] else "NOT healthy")
+            print(_health_headline(reply))
             for name, part in reply["components"].items():
-                detail = part.get("detail") or part.get("model") or part.get("backend") or part.get("path") or ""
-                print(f"  {name:<11} {'ok ' if part.get('ok') else 'BAD'}  {detail}")
+                mark = "ok " if part.get("ok") else "off" if part.get("enabled") is False else "BAD"
+                print(f"  {name:<11} {mark}  {part.get('detail', '')}")
+                if part.get("help"):
+                    print(f"  {'':<11}      = help: {part['help']}")
         return 0 if reply["healthy"] else 1
 
     return _call(args, action)
+
+
+def _health_headline(reply: dict[str, Any]) -> str:
+    bad = [
+        name for name, part in reply["components"].items() if not part.get("ok") and part.get("enabled") is not False
+    ]
+    if not reply["healthy"]:
+        return f"NOT healthy: {', '.join(bad)} {'is' if len(bad) == 1 else 'are'} not working"
+    if bad:
+        return f"working, but {', '.join(bad)} {'needs' if len(bad) == 1 else 'need'} attention"
+    return "healthy"
 
 
 def _history(args: argparse.Namespace) -> int:

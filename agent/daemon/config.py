@@ -58,7 +58,11 @@ class ApiConfig:
     )
     max_clients: int = field(
         default=128,
-        metadata=_doc("Most connections served at once; the next one gets a `busy` error and is closed.", min=1),
+        metadata=_doc(
+            "Most connections served at once. Past it a connection may still send one `estop` (an emergency "
+            "stop is never locked out); anything else gets a `busy` error and is closed.",
+            min=1,
+        ),
     )
     client_queue: int = field(
         default=1024,

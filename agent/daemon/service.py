@@ -20,6 +20,7 @@ from typing import Any
 from agent.daemon.audit import AuditError, AuditLog
 from agent.daemon.config import Config
 from agent.daemon.events import EventBus
+from agent.daemon.health import describe
 from agent.daemon.protocol import ProtocolError
 from agent.daemon.tasks import Busy, Peer, Task, TaskQueue, TaskState
 
@@ -270,8 +271,13 @@ class Service:
             "robot": robot,
             "audit": {"ok": self.audit._file is not None, "path": str(self.audit.path)},
             "speech": speech,
-            "estop": {"ok": self._estop_reason is None, "latched": self._estop_reason is not None},
+            "estop": {
+                "ok": self._estop_reason is None,
+                "latched": self._estop_reason is not None,
+                "reason": self._estop_reason,
+            },
         }
+        describe(components, backend=self.config.robot.backend, speech_problem=self.speech_problem)
         # Speech is optional: the daemon is healthy without a microphone.
         healthy = all(components[k]["ok"] for k in ("worker", "translator", "robot", "audit"))
         return healthy, components
@@ -371,7 +377,16 @@ class Service:
             task.attempts.append(entry)
             self.events.publish("attempt", task.id, **entry)
 
-        result = self.translator.translate(task.text, known_objects=known, on_attempt=on_attempt)
+        from agent.translate.engine import GenerationCancelled
+
+        try:
+            result = self.translator.translate(task.text, known_objects=known, on_attempt=on_attempt,
+                                               cancel=task.cancel)
+        except GenerationCancelled:
+            # Cut off mid-generation: a cancel or an estop need not wait for the translation to end.
+            task.mark("translate_ms", start)
+            self._finish(task, TaskState.CANCELLED, task.cancel.reason)
+            return None
         task.mark("translate_ms", start)
         task.model = getattr(result, "model", None)
         for name, value in (getattr(result, "timings_ms", None) or {}).items():

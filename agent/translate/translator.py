@@ -23,7 +23,7 @@ from agent.adapter.card import AdapterCard, card_path, read_card
 from agent.normalize import normalize_task
 from agent.translate.automaton import RslAutomaton
 from agent.translate.clauses import Clause, split_clauses
-from agent.translate.engine import Generation
+from agent.translate.engine import CancelFlag, Generation
 from agent.translate.model_path import ModelNotFoundError
 from agent.translate.prompt import (
     Shot,
@@ -65,7 +65,8 @@ _RANGE_CODES = frozenset({Code.OUT_OF_RANGE, Code.NOT_POSITIVE, Code.OUTSIDE_WOR
 class Engine(Protocol):
     chat_template: str
 
-    def generate(self, prompt: str, automaton: RslAutomaton | None, max_tokens: int) -> Generation: ...
+    def generate(self, prompt: str, automaton: RslAutomaton | None, max_tokens: int,
+                 cancel: CancelFlag | None = None) -> Generation: ...
 
     def close(self) -> None: ...
 
@@ -165,12 +166,14 @@ class Translator:
             self.engine.close()
 
     def translate(self, task: str, *, known_objects: Collection[str] | None = None,
-                  on_attempt: Callable[[Attempt], None] | None = None) -> TranslationResult:
+                  on_attempt: Callable[[Attempt], None] | None = None,
+                  cancel: CancelFlag | None = None) -> TranslationResult:
+        """`cancel` set mid-way raises `GenerationCancelled` from the model call."""
         with self._lock:
-            return self._translate(task, known_objects, on_attempt)
+            return self._translate(task, known_objects, on_attempt, cancel)
 
     def _translate(self, task: str, known: Collection[str] | None,
-                   on_attempt: Callable[[Attempt], None] | None) -> TranslationResult:
+                   on_attempt: Callable[[Attempt], None] | None, cancel: CancelFlag | None) -> TranslationResult:
         started = time.perf_counter()
         timings = {"prompt": 0.0, "generate": 0.0, "compile": 0.0}
         normalized = normalize_task(task)
@@ -197,7 +200,7 @@ class Translator:
         for _ in range(self.options.max_passes):
             for state in pending:
                 prompt = self.prompt_for(state.clause.text, state.extra)
-                generation = self.engine.generate(prompt, self._automaton(state), MAX_TOKENS)
+                generation = self.engine.generate(prompt, self._automaton(state), MAX_TOKENS, cancel)
                 timings["prompt"] += generation.prompt_ms
                 timings["generate"] += generation.generate_ms
                 state.program = _tidy(generation.text)
