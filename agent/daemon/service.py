@@ -433,7 +433,15 @@ class Service:
             )
 
         assert self._execute_plan is not None, "load() sets the executor"
-        result = self._execute_plan(plan, self.robot, self.profile, cancel=task.cancel, on_event=on_step)
+        speech = self.speech
+        if speech is not None:
+            # While the robot moves, a stop-only listener hears "stop" without the wake word (barge-in).
+            _quietly(lambda: speech.guard(True))
+        try:
+            result = self._execute_plan(plan, self.robot, self.profile, cancel=task.cancel, on_event=on_step)
+        finally:
+            if speech is not None:
+                _quietly(lambda: speech.guard(False))
         task.mark("total_ms", start)
         status = getattr(result.status, "value", result.status)
         final_state = result.final_state.to_dict() if result.final_state is not None else None
@@ -532,6 +540,8 @@ class Service:
             log.info("heard %r: robot stopped, cancelled %s", text, cancelled or "nothing")
             self.events.publish("speech", None, state="stop", detail={"text": text, "cancelled": cancelled})
             return
+        if getattr(transcript, "source", None) == "barge_in":
+            return  # the stop listener only ever stops; nothing it hears becomes a task
         heard = transcript.to_dict() if hasattr(transcript, "to_dict") else {"text": text}
 
         def announce(task: Task) -> None:
