@@ -452,10 +452,16 @@ class Service:
         assert self._execute_plan is not None, "load() sets the executor"
         recorder = self._recorder(task)
         on_event = on_step if recorder is None else _both(recorder.on_event, on_step)
+        speech = self.speech
+        if speech is not None:
+            # While the robot moves, a stop-only listener hears "stop" without the wake word (barge-in).
+            _quietly(lambda: speech.guard(True))
         result = None
         try:
             result = self._execute_plan(plan, self.robot, self.profile, cancel=task.cancel, on_event=on_event)
         finally:
+            if speech is not None:
+                _quietly(lambda: speech.guard(False))
             if recorder is not None:
                 _save_pictures(task, recorder, result)
         task.mark("total_ms", start)
@@ -568,6 +574,8 @@ class Service:
             log.info("heard %r: robot stopped, cancelled %s", text, cancelled or "nothing")
             self.events.publish("speech", None, state="stop", detail={"text": text, "cancelled": cancelled})
             return
+        if getattr(transcript, "source", None) == "barge_in":
+            return  # the stop listener only ever stops; nothing it hears becomes a task
         heard = transcript.to_dict() if hasattr(transcript, "to_dict") else {"text": text}
 
         def announce(task: Task) -> None:

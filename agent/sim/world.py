@@ -7,6 +7,9 @@ its head limits come from the robot profile (the one source of truth):
   commanded body-frame (linear, angular) velocity every physics step, changing
   it no faster than the motors can (`MOTOR_ACCEL`), so even an emergency stop
   takes a few physics steps, as on a real base;
+- a bumper round the base: a motion that would press the base into anything
+  but the floor stops it dead before it touches, and `blocked_by` names what
+  was in the way, so the robot never shoves furniture (or a person);
 - a mast with a pan-tilt head and a camera (position-controlled joints that
   move no faster than `profile.motion.max_head_speed`);
 - a fixed arm with a two-finger gripper at `GRIPPER_HEIGHT`; `grasp` pulls an
@@ -49,6 +52,20 @@ CAMERA_RANGE = 8.0  # m
 GRASP_BEARING = math.radians(60.0)  # the gripper only reaches objects roughly in front
 GRASP_FORCE = 60.0  # N, so a pinned object resists instead of teleporting
 TRAJECTORY_LIMIT = PHYSICS_HZ * 600  # samples kept: ten minutes, so a long-running bridge does not grow
+# Real-time pacing catches up a lag shorter than this (a busy CPU for a moment); a longer one (the world
+# sat idle between motions) restarts the pacing clock, so later motions never run faster than real time.
+PACING_SLACK = 0.05  # s of wall time
+BUMPER_GAP = 0.003  # m: the bumper trips this close to an obstacle, on top of one physics step's travel
+BASE_RADIUS = math.hypot(BASE_SIZE[0], BASE_SIZE[1]) / 2  # how fast a corner moves when the base turns
+
+
+@dataclass(frozen=True)
+class Contact:
+    """What stopped the base: an obstacle, and the point on the base that was about to touch it."""
+
+    name: str
+    x: float
+    y: float
 
 
 @dataclass(frozen=True)
@@ -189,7 +206,10 @@ class SimWorld:
         self._velocity = (0.0, 0.0)
         self._head_target = (0.0, 0.0)
         self._grip_constraint: int | None = None
-        self._wall_start = time.monotonic()
+        self.blocked_by: Contact | None = None
+        # Wall time at which the simulation clock read `_pace_sim`: real-time pacing counts from here.
+        self._pace_wall = time.monotonic()
+        self._pace_sim = 0.0
         with _stdout_to_stderr():
             self._client = BulletClient(connection_mode=pybullet.DIRECT)
         self._closed = False
@@ -269,12 +289,19 @@ class SimWorld:
             self._pose = None
             self.sim_time += self.dt
             if self.realtime_factor > 0:
-                ahead = self._wall_start + self.sim_time / self.realtime_factor - time.monotonic()
-                if ahead > 0:
-                    time.sleep(ahead)
+                self._pace()
             self._log_sample()
             for listener in self._listeners:
                 listener(self)
+
+    def _pace(self) -> None:
+        """Sleep until the wall clock has caught up with the simulation, at `realtime_factor`."""
+        now = time.monotonic()
+        ahead = self._pace_wall + (self.sim_time - self._pace_sim) / self.realtime_factor - now
+        if ahead < -PACING_SLACK:
+            self._pace_wall, self._pace_sim = now, self.sim_time
+        elif ahead > 0:
+            time.sleep(ahead)
 
     def _apply_base_velocity(self) -> None:
         client = self._client
@@ -282,10 +309,33 @@ class SimWorld:
         max_dv, max_dw = MOTOR_ACCEL[0] * self.dt, MOTOR_ACCEL[1] * self.dt
         v += max(-max_dv, min(max_dv, target_v - v))
         w += max(-max_dw, min(max_dw, target_w - w))
+        self.blocked_by = self._obstacle_ahead(v, w) if (v or w) else None
+        if self.blocked_by is not None:
+            # A bumper cuts the drive at once; the motors' ramp does not apply to hitting something.
+            v = w = 0.0
         self._velocity = (v, w)
         heading = self.base_pose().heading
         vz = client.getBaseVelocity(self._robot)[0][2]
         client.resetBaseVelocity(self._robot, [v * math.cos(heading), v * math.sin(heading), vz], [0.0, 0.0, w])
+
+    def _obstacle_ahead(self, v: float, w: float) -> Contact | None:
+        """The first object that driving at (v, w) for one more step would press the base into, if any."""
+        client = self._client
+        reach = (abs(v) + abs(w) * BASE_RADIUS) * self.dt + BUMPER_GAP
+        low, high = client.getAABB(self._robot, -1)
+        nearby = client.getOverlappingObjects([low[0] - reach, low[1] - reach, low[2]],
+                                              [high[0] + reach, high[1] + reach, high[2]]) or ()
+        held = self._bodies.get(self.holding) if self.holding is not None else None
+        pose = self.base_pose()
+        cos_h, sin_h = math.cos(pose.heading), math.sin(pose.heading)
+        for uid in sorted({uid for uid, _link in nearby} - {self._robot, self._floor, held}):
+            for point in client.getClosestPoints(self._robot, uid, reach, linkIndexA=-1):
+                (ax, ay, _), (nx, ny, _) = point[5], point[7]  # the point on the base; normal towards it
+                # The velocity of that point of the base, turning included, against the normal.
+                ux, uy = v * cos_h - w * (ay - pose.y), v * sin_h + w * (ax - pose.x)
+                if ux * nx + uy * ny < 0:
+                    return Contact(self._names.get(uid, "an obstacle"), ax, ay)
+        return None
 
     def _log_sample(self) -> None:
         pose = self.base_pose()

@@ -1,10 +1,15 @@
 """Live speech input: microphone -> wake word or push-to-talk -> Vosk -> transcript.
 
 One worker thread owns the audio stream and the recognisers, so Vosk is never
-used from two threads. PortAudio's callback only queues raw blocks. Nothing
-here may take the daemon down: a missing model or microphone, a device that
-disappears, or a callback that raises is logged, reported in `health()` and
-retried, while the rest of the daemon keeps serving.
+used from two threads. PortAudio's callback only queues raw blocks. While the
+robot moves (`guard(True)`), a stop-only listener (agent.speech.stop) hears
+every loud block as well, without the wake word: its only possible output is
+a stop, handed on as a `barge_in` transcript of the stop word, and it drops
+any task utterance in progress, so a stop misheard by the task recogniser
+cannot become a motion. Nothing here may take the daemon down: a missing
+model or microphone, a device that disappears, or a callback that raises is
+logged, reported in `health()` and retried, while the rest of the daemon
+keeps serving.
 """
 
 from __future__ import annotations
@@ -22,8 +27,9 @@ from agent.speech.feedback import Speaker, describe
 from agent.speech.lexicon import lexicon_for
 from agent.speech.recognizer import LoadedModel, load_model
 from agent.speech.records import SpeechConfig, SpeechEvent, Transcript, TranscriptSource
-from agent.speech.spotting import TimedRecognizer, WakeSpotter, trim_leading_quiet, words_after
-from agent.speech.vocabulary import UNKNOWN, Vocabulary
+from agent.speech.spotting import TimedRecognizer, WakeSpotter, keyword_grammar, trim_leading_quiet, words_after
+from agent.speech.stop import StopHeard, StopSpotter, stop_grammar
+from agent.speech.vocabulary import Vocabulary
 from rsl.plan import Command
 
 log = logging.getLogger("nrtrans.speech")
@@ -62,6 +68,7 @@ class SpeechInput:
         self._stopping = threading.Event()
         self._push_to_talk = threading.Event()
         self._objects_changed = threading.Event()
+        self._guarding = threading.Event()
         self._objects: tuple[str, ...] = tuple(config.objects)
         self._thread: threading.Thread | None = None
         self._blocks: queue.Queue[bytes] = queue.Queue(maxsize=QUEUE_BLOCKS)
@@ -106,6 +113,13 @@ class SpeechInput:
             raise SpeechUnavailable(f"speech input cannot listen now ({state}"
                                     f"{': ' + problem if problem else ''}); see `nrtrans health`")
         self._push_to_talk.set()
+
+    def guard(self, moving: bool) -> None:
+        """Tell the speech input whether the robot is moving: the stop listener runs only then."""
+        if moving:
+            self._guarding.set()
+        else:
+            self._guarding.clear()
 
     def announce(self, command: Command) -> bool:
         """Say a plan step aloud when `feedback` is on; never blocks, never raises."""
@@ -265,8 +279,16 @@ class SpeechInput:
         vocabulary = self._vocabulary(model)
         bias = self.config.grammar_bias and model.runtime_grammar
         task = TimedRecognizer(model.recognizer(rate, vocabulary.grammar() if bias else None), rate)
-        spotter = WakeSpotter(TimedRecognizer(model.recognizer(rate, self._wake_grammar(vocabulary)), rate),
-                              self._wake_words, PREROLL_S) if self._wake_words else None
+        spotter = None
+        if self._wake_words:
+            grammar = keyword_grammar(self._wake_words, vocabulary, long_decoys_only=True)
+            wake = TimedRecognizer(model.recognizer(rate, grammar), rate)
+            spotter = WakeSpotter(wake, self._wake_words, PREROLL_S)
+        stop_words = [w for w in lexicon_for(self.config.language).stop_words if model.find_word(w) >= 0]
+        stop = StopSpotter(TimedRecognizer(model.recognizer(rate, stop_grammar(stop_words, vocabulary)), rate),
+                           stop_words, self.config.stop_threshold) \
+            if self.config.barge_in and stop_words and model.runtime_grammar else None
+        holdoff = False  # after a barge-in, until that stretch of speech ends
         utterance: _Utterance | None = None
         idle_state = "waiting_for_wake_word" if spotter is not None else "push_to_talk_only"
         self._set_state(idle_state)
@@ -281,6 +303,22 @@ class SpeechInput:
                     raise _DeviceLost("the audio device stopped delivering sound") from None
                 continue
             last_block = time.monotonic()
+            if stop is not None and (self._guarding.is_set() or holdoff):
+                heard = stop.feed(block)
+                if heard is not None and self._guarding.is_set() and not holdoff:
+                    self._barge_in(heard, task, utterance)
+                    utterance = None
+                    if spotter is not None:
+                        spotter.reset()
+                    self._set_state(idle_state)
+                    # The rest of this breath is not for the wake word either: "정지" heard as "로봇 전진"
+                    # must not start a task once the robot has stopped.
+                    holdoff = True
+                if holdoff:
+                    holdoff = stop.active
+                    continue
+            elif stop is not None and stop.active:
+                stop.reset()
             if utterance is None and self._objects_changed.is_set():
                 self._objects_changed.clear()
                 vocabulary = self._vocabulary(model)
@@ -298,14 +336,17 @@ class SpeechInput:
             if utterance is None:
                 self._set_state(idle_state)
 
-    def _wake_grammar(self, vocabulary: Vocabulary) -> str:
-        import json
-
-        # Without [unk] a closed grammar would hear the wake word in every
-        # sound; the other task words give non-wake speech somewhere to go.
-        others = [UNKNOWN] if vocabulary.has_unknown else [w for w in vocabulary.words
-                                                             if w not in self._wake_words]
-        return json.dumps([*self._wake_words, *others], ensure_ascii=False)
+    def _barge_in(self, heard: StopHeard, task: TimedRecognizer, utterance: _Utterance | None) -> None:
+        """A stop heard while the robot moves: drop the utterance in progress and hand on only the stop."""
+        if utterance is not None:
+            task.reset()
+        now = time.time()
+        try:
+            self._on_transcript(Transcript(heard.word, now, now, "barge_in"))
+        except Exception:
+            log.exception("the transcript handler failed for the stop word %r", heard.word)
+        self._emit("stop_heard", word=heard.word, confidence=round(heard.confidence, 3),
+                   dropped_utterance=utterance is not None)
 
     def _begin(self, task: TimedRecognizer, source: TranscriptSource, audio: tuple[bytes, ...],
                wake_end_s: float | None = None, follow_up: bool = False) -> _Utterance:

@@ -6,7 +6,8 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
-TranscriptSource = Literal["wake_word", "push_to_talk", "file"]
+# barge_in: the stop listener heard a stop word while the robot moved; the text is only ever that word.
+TranscriptSource = Literal["wake_word", "push_to_talk", "file", "barge_in"]
 
 
 class SpeechConfigError(ValueError):
@@ -46,6 +47,10 @@ class SpeechConfig:
     # Say each step aloud through espeak-ng ("moving forward two meters").
     feedback: bool = False
     feedback_voice: str = "en-us"
+    # While the robot moves, listen for the stop words alone, without the wake word (docs/speech.md).
+    barge_in: bool = True
+    # Vosk word confidence a stop word needs to stop the robot (bench/bench_stop_spotter.py).
+    stop_threshold: float = 0.3
 
     @classmethod
     def from_dict(cls, options: dict[str, Any]) -> SpeechConfig:
@@ -71,6 +76,9 @@ class SpeechConfig:
             (isinstance(self.enabled, bool), "enabled must be true or false"),
             (isinstance(self.grammar_bias, bool), "grammar_bias must be true or false"),
             (isinstance(self.feedback, bool), "feedback must be true or false"),
+            (isinstance(self.barge_in, bool), "barge_in must be true or false"),
+            (isinstance(self.stop_threshold, int | float) and 0.0 <= self.stop_threshold <= 1.0,
+             "stop_threshold must be from 0 to 1"),
             (isinstance(self.feedback_voice, str) and bool(self.feedback_voice),
              "feedback_voice must be an espeak-ng voice name, like \"en-us\""),
             (self.model is None or isinstance(self.model, str), "model must be a name or a path"),
@@ -108,8 +116,8 @@ class Transcript:
 class SpeechEvent:
     """Something the speech input did or ran into, for the event stream and logs.
 
-    kinds: ready, wake, listening, heard, no_speech, empty, device_error,
-    device_lost, model_error, stopped.
+    kinds: ready, wake, listening, heard, stop_heard, no_speech, empty,
+    device_error, device_lost, model_error, stopped.
     """
 
     kind: str

@@ -59,3 +59,18 @@ def test_spoken_task_is_heard_queued_and_audited(workdir: Path, mic: VirtualMic)
         assert record["source"] == "voice" and record["peer"] is None
         assert record["transcript"]["text"] == heard["text"] == record["text"]
         client.cancel(heard["task"])
+
+
+def test_a_spoken_stop_halts_the_moving_robot_without_the_wake_word(workdir: Path, mic: VirtualMic) -> None:
+    # Issue 13: a stop had to pass the wake word and the task recogniser, which heard "정지" as "전진".
+    wav = speak("멈춰", workdir / "stop.wav")
+    with _listening(workdir) as client:
+        task = client.submit(rsl="forward 5;")
+        next(e for e in client.events() if e["event"] == "executing" and e["task"] == task)
+        time.sleep(0.5)
+        mic.play(wav)
+        stop = next(check_frame(e) for e in client.events() if e["event"] == "speech" and e["state"] == "stop")
+        assert stop["detail"]["text"] == "멈춰" and stop["detail"]["cancelled"] == [task]
+        final = next(check_frame(e) for e in client.events() if e["task"] == task and e["event"] != "step")
+        assert final["event"] == "cancelled" and "stopped by voice" in final["reason"], final
+        assert final["state"]["pose"]["x"] < 4.5, "the robot drove on to the end"

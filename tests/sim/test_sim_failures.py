@@ -136,13 +136,12 @@ def test_stop_from_another_thread_ends_the_motion(profile: Profile) -> None:
         assert robot.forward(0.2).ok  # a later step runs normally
 
 
-def test_a_blocked_motion_times_out_with_what_is_left(profile: Profile) -> None:
-    quick = dataclasses.replace(profile, motion=dataclasses.replace(profile.motion, timeout_margin=1.0))
-    with SimRobot(quick, parse_scene(WALL_SCENE, "wall")) as robot:
-        result = execute(plan_of("forward 3; turnleft 1;", quick), robot, quick)
+def test_a_blocked_motion_stops_at_the_obstacle_with_what_is_left(profile: Profile) -> None:
+    with SimRobot(profile, parse_scene(WALL_SCENE, "wall")) as robot:
+        result = execute(plan_of("forward 3; turnleft 1;", profile), robot, profile)
         assert result.status is Status.FAILED and len(result.outcomes) == 1
         reason = result.outcomes[0].reason
-        assert "timed out after 7.5 s" in reason and "still to go" in reason, reason
+        assert "the wall is in the way" in reason and "2.11 m still to go" in reason, reason
         assert robot.state().pose.x < 1.0  # the wall held it
         assert robot.world.base_velocity() == pytest.approx((0.0, 0.0), abs=0.01)
 

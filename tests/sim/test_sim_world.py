@@ -11,7 +11,7 @@ from agent.backends import BackendError, open_robot
 from agent.robot import Robot
 from agent.sim.robot import SimRobot
 from agent.sim.scene import SceneError, load_scene, parse_scene
-from agent.sim.world import SimWorld
+from agent.sim.world import BASE_SIZE, SimWorld
 from rsl.profile import Profile
 
 
@@ -101,13 +101,40 @@ def test_open_robot_gives_the_simulator_and_rejects_unknown_backends(profile: Pr
         open_robot("sim", profile, node_name="x")
 
 
-def test_resting_objects_wake_when_the_robot_pushes_them(profile: Profile) -> None:
-    robot = SimRobot(profile)
-    try:
+def test_driving_into_the_table_stops_at_it_and_names_it(profile: Profile) -> None:
+    # Issue 13: `forward 5;` facing the 25 kg table used to shove it 2.64 m and fail only by timeout.
+    with SimRobot(profile) as robot:
+        table = robot.world.scene.object("table")
+        near_face = table.x - table.size[0] / 2
+        outcome = robot.forward(5.0)
+        assert not outcome.ok
+        assert outcome.reason.startswith("driving forward stopped: the table is in the way"), outcome.reason
+        x, y, _ = robot.world.objects()["table"]
+        assert math.hypot(x - table.x, y - table.y) <= 0.02, "the table was pushed"
+        gap = near_face - (robot.state().pose.x + BASE_SIZE[0] / 2)
+        assert 0.0 <= gap <= 0.1, gap
+        assert robot.world.base_velocity() == pytest.approx((0.0, 0.0), abs=0.01)
+        assert robot.backward(1.0).ok  # the bumper only holds back motion into the obstacle
+
+
+def test_the_bumper_catches_a_sleeping_object_too(profile: Profile) -> None:
+    with SimRobot(profile) as robot:
         robot.world.step(300)  # long enough for the objects to fall asleep
         assert robot.turnleft(math.atan2(1.8, 1.5)).ok
-        assert robot.forward(2.8).ok
+        outcome = robot.forward(2.8)
+        assert not outcome.ok and "the ball is in the way" in outcome.reason, outcome.reason
         bx, by, _ = robot.world.objects()["ball"]
-        assert math.hypot(bx - 1.5, by - 1.8) > 0.5  # shoved ahead of the base, not driven through
-    finally:
-        robot.close()
+        assert math.hypot(bx - 1.5, by - 1.8) < 0.02  # not shoved, and not driven through
+
+
+def test_real_time_pacing_holds_after_the_world_sat_idle(profile: Profile) -> None:
+    # Issue 13: pacing against a clock fixed at start let every second of idle run unpaced later.
+    with SimRobot(profile, realtime_factor=1.0) as robot:
+        time.sleep(1.5)  # idle, as a daemon between tasks
+        started = time.monotonic()
+        sim_started = robot.world.sim_time
+        assert robot.forward(1.0).ok
+        wall = time.monotonic() - started
+        simulated = robot.world.sim_time - sim_started
+    assert simulated > 2.0
+    assert wall >= simulated - 0.1, (wall, simulated)

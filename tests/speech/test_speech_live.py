@@ -121,3 +121,23 @@ def test_lone_wake_word_then_task_and_a_failing_handler(mic, say) -> None:
         assert len(calls) == transcripts + 1, f"the input stopped listening after the handler raised: {kinds}"
     finally:
         speech.stop()
+
+
+def test_a_stop_while_the_robot_moves_needs_no_wake_word_and_starts_nothing(mic, say, collector) -> None:
+    # Issue 13: a spoken stop went through the wake word and the task recogniser, which heard "정지" as "전진".
+    config = SpeechConfig(**KOREAN)
+    with running(config, collector) as speech:
+        wait_for(lambda: speech.health()["state"] == "waiting_for_wake_word", 30, "the wake-word state")
+        speech.guard(True)
+        mic.play(say("로봇 멈춰"))
+        transcript = collector.transcripts.get(timeout=15)
+        assert (transcript.text, transcript.source) == ("멈춰", "barge_in")
+        time.sleep(2.0)  # the rest of that breath: no wake word, no task
+        assert collector.transcripts.empty(), collector.transcripts.get()
+        heard = [e for e in collector.events if e.kind == "stop_heard"]
+        assert len(heard) == 1 and heard[0].detail["word"] == "멈춰"
+
+        speech.guard(False)  # standing still: a bare stop word is not for the robot
+        mic.play(say("멈춰"))
+        time.sleep(2.0)
+        assert collector.transcripts.empty()
