@@ -15,15 +15,17 @@ import math
 from collections.abc import Sequence
 
 from rsl.profile import IDENTIFIER, Param, Profile, Skill
+from rsl.syntax import NO_PROGRAM
 
 MAX_FRACTION_DIGITS = 4
 
 
-def to_gbnf(profile: Profile, objects: Sequence[str] | None = None) -> str:
+def to_gbnf(profile: Profile, objects: Sequence[str] | None = None, *, refusal: bool = False) -> str:
     """The grammar; `objects` narrows object arguments to those names.
 
     With an empty `objects` list, skills that need an object are left out,
-    since no valid statement could use them.
+    since no valid statement could use them. With `refusal`, the single line
+    `NO_PROGRAM` may stand in place of the statements.
     """
     if objects is not None:
         bad = [name for name in objects if not IDENTIFIER.match(name)]
@@ -40,7 +42,8 @@ def to_gbnf(profile: Profile, objects: Sequence[str] | None = None) -> str:
     if any(p.kind == "object" for s in skills for p in s.params):
         rules["object"] = _object_rule(objects)
     lines = [
-        f"root ::= statement{{1,{profile.max_statements}}} \"\\n\"",
+        f"root ::= statement{{1,{profile.max_statements}}} \"\\n\""
+        + (f" | \"{NO_PROGRAM}\\n\\n\"" if refusal else ""),
         f"statement ::= ({' | '.join(statement_rules)}) \"\\n\"",
     ]
     lines.extend(f"{name} ::= {body}" for name, body in rules.items())

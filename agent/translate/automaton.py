@@ -16,6 +16,7 @@ from typing import Any
 
 from rsl.grammar import MAX_FRACTION_DIGITS
 from rsl.profile import IDENTIFIER, Param, Profile, Skill
+from rsl.syntax import NO_PROGRAM
 
 State = tuple[Any, ...]
 
@@ -24,7 +25,7 @@ END: State = ("END",)
 MAX_IDENTIFIER = 32
 _IDENT_FIRST = frozenset(string.ascii_letters + "_")
 _IDENT_REST = frozenset(string.ascii_letters + string.digits + "_")
-ALPHABET = frozenset(string.ascii_letters + string.digits + "_.,;- \n")
+ALPHABET = frozenset(string.ascii_letters + string.digits + "_.,;- \n" + NO_PROGRAM)
 
 
 class RslAutomaton:
@@ -32,7 +33,7 @@ class RslAutomaton:
 
     def __init__(self, profile: Profile, *, keywords: Collection[str] | None = None,
                  objects: Sequence[str] | None = None, numbers: Mapping[str, Collection[str]] | None = None,
-                 max_statements: int | None = None) -> None:
+                 max_statements: int | None = None, refusal: bool = False) -> None:
         if objects is not None:
             bad = [o for o in objects if not IDENTIFIER.match(o)]
             if bad:
@@ -51,10 +52,12 @@ class RslAutomaton:
         # The decoder ends the program at this many statements, so a run-on
         # model repeating its last line stops; the compiler's cap stays the law.
         self.max_statements = max_statements or profile.max_statements
+        # With `refusal`, the program may instead be the single line NO_PROGRAM.
+        self.refusal = refusal
         self.key = (tuple(sorted(self.skills)), self.objects,
                     None if self.numbers is None else tuple(sorted((u, tuple(sorted(v)))
                                                                    for u, v in self.numbers.items())),
-                    self.max_statements)
+                    self.max_statements, refusal)
         self._number_shape = {(s.keyword, i): _number_shape(p) for s in self.skills.values()
                               for i, p in enumerate(s.params) if p.kind == "number"}
         self._memo: dict[tuple[State, str], State | None] = {}
@@ -80,7 +83,11 @@ class RslAutomaton:
         if kind == "S":
             if char == "\n" and state[1]:
                 return END
+            if self.refusal and not state[1] and char == NO_PROGRAM[0]:
+                return ("R", 1)
             return self._keyword(char)
+        if kind == "R":
+            return self._in_refusal(state[1], char)
         if kind == "K":
             return self._in_keyword(state[1], char)
         if kind == "C":
@@ -90,6 +97,13 @@ class RslAutomaton:
         if kind == "NL":
             return ("S", True) if char == "\n" else None
         return None
+
+    def _in_refusal(self, matched: int, char: str) -> State | None:
+        """The refusal line, then its newline, then the blank line that ends every program."""
+        line = NO_PROGRAM + "\n"
+        if matched < len(line):
+            return ("R", matched + 1) if char == line[matched] else None
+        return END if char == "\n" else None
 
     def _keyword(self, prefix_char: str) -> State | None:
         return ("K", prefix_char) if any(k.startswith(prefix_char) for k in self.skills) else None
@@ -172,7 +186,8 @@ class RslAutomaton:
             parts = [self._gbnf_param(skill.keyword, i, p, rules) for i, p in enumerate(skill.params)]
             body = f'"{skill.keyword} " ' + ' ", " '.join(parts) + ' ";"' if parts else f'"{skill.keyword};"'
             alternatives.append(body)
-        lines = ['root ::= statement+ "\\n"', f'statement ::= ({" | ".join(alternatives)}) "\\n"']
+        root = 'root ::= statement+ "\\n"' + (f' | "{NO_PROGRAM}\\n\\n"' if self.refusal else "")
+        lines = [root, f'statement ::= ({" | ".join(alternatives)}) "\\n"']
         lines.extend(f"{name} ::= {body}" for name, body in rules.items())
         return "\n".join(lines) + "\n"
 

@@ -38,6 +38,7 @@ from rsl.compiler import compile_program
 from rsl.diagnostics import Code, Diagnostic
 from rsl.plan import Quantity, format_number
 from rsl.profile import Convention, Profile
+from rsl.syntax import NO_PROGRAM
 
 MAX_TOKENS = 160
 # One clause rarely needs more; a square is 8 statements.
@@ -84,6 +85,9 @@ class Options:
     # Refuse a clause the model does not read as a robot task ("what time is it"): the grammar would
     # force some program out of it. Only with the adapter, whose first-token confidence was measured.
     refuse_unclear: bool = False
+    # Let the grammar offer NO_PROGRAM in place of statements, for a model trained to write it
+    # for words that are not a task; writing it refuses the clause with E201, without repair.
+    refusal: bool = False
 
 
 @dataclass
@@ -96,6 +100,7 @@ class _ClauseState:
     max_statements: int | None = None
     free_numbers: bool = False  # set after a range error, so the repair may pick any number
     unclear: tuple[str, float] | None = None  # (the model's first choice, its probability) when not a task
+    refused: bool = False  # the model wrote NO_PROGRAM
     lines: tuple[int, int] = (0, 0)
     timings: dict[str, float] = field(default_factory=dict)
 
@@ -148,7 +153,7 @@ class Translator:
                           shots=(0 if use_adapter else DEFAULT_SHOTS) if shots is None else shots,
                           split_clauses=split_clauses, narrow=narrow, narrow_skills=not use_adapter,
                           adapter_prompt=use_adapter, prefix_shots=prefix_shots and not use_adapter,
-                          refuse_unclear=use_adapter)
+                          refuse_unclear=use_adapter, refusal=use_adapter)
         return cls(profile, engine, name, options)
 
     def close(self) -> None:
@@ -185,13 +190,14 @@ class Translator:
                 timings["prompt"] += generation.prompt_ms
                 timings["generate"] += generation.generate_ms
                 state.program = _tidy(generation.text)
+                state.refused = self.options.refusal and state.program == NO_PROGRAM + "\n"
                 if self.options.refuse_unclear and not attempts and not _reads_as_task(generation, self.profile):
                     state.unclear = (generation.first_piece, generation.first_probability or 0.0)
             program = _assemble(states)
             compile_started = time.perf_counter()
             result = compile_program(program, self.profile, known)
             timings["compile"] += (time.perf_counter() - compile_started) * 1000
-            unclear = [self._not_a_task(state) for state in states if state.unclear is not None]
+            unclear = [self._not_a_task(state) for state in states if state.unclear is not None or state.refused]
             attempt = Attempt(program=program, diagnostics=(*unclear, *result.diagnostics))
             attempts.append(attempt)
             if on_attempt is not None:
@@ -252,10 +258,11 @@ class Translator:
                 self._automata.clear()
             try:
                 automaton = RslAutomaton(self.profile, keywords=state.keywords, objects=state.objects,
-                                         numbers=numbers, max_statements=cap)
+                                         numbers=numbers, max_statements=cap, refusal=self.options.refusal)
             except ValueError:
                 # The narrowing left nothing (say, only object skills and no object): drop it.
-                automaton = RslAutomaton(self.profile, objects=state.objects, numbers=numbers)
+                automaton = RslAutomaton(self.profile, objects=state.objects, numbers=numbers,
+                                         refusal=self.options.refusal)
             self._automata[key] = automaton
         return automaton
 
@@ -335,15 +342,19 @@ class Translator:
         return tuple(dict.fromkeys(names)) or None
 
     def _not_a_task(self, state: _ClauseState) -> Diagnostic:
-        assert state.unclear is not None
-        piece, probability = state.unclear
+        if state.refused:
+            reason = "the model wrote that it has no program for it"
+        else:
+            assert state.unclear is not None
+            piece, probability = state.unclear
+            reason = f"the model would begin with {piece.strip()!r}, {probability:.0%} sure"
         written = state.program.splitlines()[0] if state.program.strip() else ""
         examples = " or ".join(f"'{c.task}'" for c in self.profile.conventions[:2] if c.task)
         return Diagnostic(
             code=Code.NOT_A_TASK, line=state.lines[0], column=1, token=written or state.clause.text,
             message=f"'{state.clause.text}' does not read as a task for this robot, so nothing was run; "
                     f"say what it should do" + (f", for example {examples}" if examples else "")
-                    + f" (the model would begin with {piece.strip()!r}, {probability:.0%} sure)",
+                    + f" ({reason})",
             source_line=written or state.clause.text)
 
     def _prepare_repair(self, states: list[_ClauseState], diagnostics: tuple[Diagnostic, ...],
