@@ -24,6 +24,7 @@ from agent.adapter.prompt import adapter_prompt
 from agent.normalize import normalize_task
 from rsl.plan import Command, ObjectRef, Plan, Quantity, format_number
 from rsl.profile import Convention, Profile, Skill
+from rsl.syntax import NO_PROGRAM
 
 OBJECTS = (
     "cup", "mug", "bottle", "ball", "box", "book", "can", "apple", "banana", "orange", "phone",
@@ -172,8 +173,6 @@ JOINERS = (", ", ", then ", " then ", " and ", " and then ", ". then ", ", after
            " and after that ", ", and then ", ". ")
 FILLERS = ("uh", "um", "uhm", "er", "okay", "please", "hmm")
 
-# The model's whole answer for words that are not a task for this robot.
-NO_PROGRAM = "// no program"
 
 # Sentence frames around a task: how people address, soften and close a request.
 OPENERS = ("robot, ", "hey robot, ", "okay robot, ", "robot ", "please ", "could you ", "can you please ",
