@@ -37,7 +37,7 @@ from agent.translate.result import Attempt, TranslationResult
 from rsl.compiler import compile_program
 from rsl.diagnostics import Code, Diagnostic
 from rsl.plan import Quantity, format_number
-from rsl.profile import Convention, Profile
+from rsl.profile import IDENTIFIER, Convention, Profile
 from rsl.syntax import NO_PROGRAM
 
 MAX_TOKENS = 160
@@ -124,13 +124,16 @@ class Translator:
     @classmethod
     def load(cls, profile: Profile, *, model: str | None = None, adapter: str | None = None,
              grammar: bool = True, max_passes: int = 3, endpoint: str | None = None, shots: int | None = None,
-             split_clauses: bool = True, narrow: bool = True, prefix_shots: bool = True) -> Translator:
+             split_clauses: bool | None = None, narrow: bool = True, prefix_shots: bool = True) -> Translator:
         """Load the model (or connect to `endpoint`).
 
         `adapter`: None for the shipped adapter when it fits the model and
         profile, "none" for no adapter, "default" for the shipped adapter of
         the embedded default model, or the path of a LoRA GGUF.
-        `shots`: None picks the mode's default.
+        `shots`, `split_clauses`: None picks the mode's default. The adapter
+        reads the whole task (it was trained on whole tasks, and splitting
+        cut vocatives, corrections and negations into steps of their own);
+        the base model gets one clause at a time.
         """
         if max_passes < 1:
             raise ValueError("max_passes must be at least 1")
@@ -151,7 +154,8 @@ class Translator:
         use_adapter = lora is not None
         options = Options(grammar=grammar, max_passes=max_passes,
                           shots=(0 if use_adapter else DEFAULT_SHOTS) if shots is None else shots,
-                          split_clauses=split_clauses, narrow=narrow, narrow_skills=not use_adapter,
+                          split_clauses=not use_adapter if split_clauses is None else split_clauses,
+                          narrow=narrow, narrow_skills=not use_adapter,
                           adapter_prompt=use_adapter, prefix_shots=prefix_shots and not use_adapter,
                           refuse_unclear=use_adapter, refusal=use_adapter)
         return cls(profile, engine, name, options)
@@ -237,7 +241,9 @@ class Translator:
         if not self.options.grammar:
             return None
         numbers = None
-        if self.options.narrow and not state.free_numbers:
+        # Numbers are narrowed per clause only: a whole task mixes said numbers with
+        # conventions and counts ("forward 1.5 m twice, then come back home" would pin goto to 1.5, 2).
+        if self.options.narrow and self.options.split_clauses and not state.free_numbers:
             # A clause that states its numbers means them; the conventions'
             # numbers are only for vague clauses. Polygon turns stay for both.
             said = _task_numbers(state.clause.text, self._units)
@@ -328,6 +334,12 @@ class Translator:
         """Object names the clause itself mentions (`the red cup` -> red_cup, cup)."""
         if not self.options.narrow:
             return None
+        if not self.options.split_clauses:
+            # A whole task: any word or pair of words it says may name an object; the model, not
+            # an adjective rule, decides which ("pick up the book gently" is `book`).
+            words = [w for w in re.findall(r"[a-z]+", text) if w not in _NOT_OBJECTS]
+            pairs = [f"{a}_{b}" for a, b in itertools.pairwise(words)]
+            return tuple(dict.fromkeys(w for w in (*words, *pairs) if IDENTIFIER.match(w))) or None
         names: list[str] = []
         for phrase in _OBJECT_PHRASE.findall(text):
             words = phrase.split()
