@@ -61,7 +61,7 @@ _FILLERS: tuple[tuple[str, ...], ...] = tuple(
             "could you", "can you", "would you", "will you", "could you please", "would you please",
             "i want you to", "i need you to", "i'd like you to", "i would like you to", "you know",
             "go ahead and", "hey robot", "ok robot", "okay robot", "okay", "ok", "alright", "just",
-            "for me", "thanks", "thank you", "robot could you", "i mean",
+            "for me", "robot could you",
         ],
         key=lambda p: -len(p.split()),
     )
@@ -183,7 +183,7 @@ def _unit_at(tokens: Sequence[str], j: int) -> tuple[str, float, int] | None:
         return "m", _LENGTHS[word], j + 1
     if word in _ANGLES:
         return "rad", _ANGLES[word], j + 1
-    if word == "full" and j + 1 < len(tokens) and tokens[j + 1] in _REVOLUTIONS:
+    if word in ("full", "complete", "whole") and j + 1 < len(tokens) and tokens[j + 1] in _REVOLUTIONS:
         return "rad", 2 * math.pi, j + 2
     return None
 
@@ -213,7 +213,8 @@ def _convert_numbers(tokens: list[str]) -> list[str]:
     i = 0
     while i < len(tokens):
         token = tokens[i]
-        converted = _convert_at(tokens, i)
+        # "the point 2, 5" names a place; "point 2" after no article is a decimal.
+        converted = None if token == "point" and out[-1:] in (["the"], ["a"]) else _convert_at(tokens, i)
         if converted is not None and converted[1] > i:
             text, i = converted
             out.append(text)

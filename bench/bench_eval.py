@@ -6,6 +6,16 @@ success (verified), mean passes and latency for each, plus the tasks each got
 wrong. Writes bench/results/eval_side_by_side.json.
 
     python bench/bench_eval.py [--adapter PATH|default] [--suite FILE] [--every K] [--out FILE]
+
+With --compare OLD NEW it instead runs the default configuration (adapter,
+grammar) with each of two adapters on the evaluation suite, the novel tasks
+and the fresh development set side by side, and writes
+bench/results/eval_adapters.json. The fresh set's per-task results are left
+out of the file: only its per-group table may be looked at. An adapter
+trained on an older prompt format is refused by the runtime; pass a copy of
+its GGUF without the card to compare it anyway.
+
+    python bench/bench_eval.py --compare /tmp/old.gguf models/adapters/rsl-default-gemma3-270m-q4km.gguf
 """
 
 from __future__ import annotations
@@ -24,6 +34,10 @@ from agent.evalsuite.runner import render_table, run_suite, summarize
 from agent.translate import Translator
 from rsl.profile import load_profile
 
+SETS = {"suite": None, "novel": "bench/novel_tasks.toml", "dev": "bench/fresh/dev.toml"}
+# Sets whose tasks nobody may read: only their per-group table is kept.
+FRESH = ("bench/fresh/",)
+
 CONFIGURATIONS = (
     ("base, shots, no grammar", {"adapter": "none", "grammar": False}),
     ("base, shots, grammar", {"adapter": "none", "grammar": True}),
@@ -37,8 +51,18 @@ def main() -> int:
     parser.add_argument("--adapter", default="default", help="adapter GGUF to measure (default: the shipped one)")
     parser.add_argument("--suite", metavar="FILE", help="another suite file (default: the evaluation suite)")
     parser.add_argument("--every", type=int, default=1, metavar="K", help="only every K-th task (default: all)")
-    parser.add_argument("--out", default="bench/results/eval_side_by_side.json")
+    parser.add_argument("--out", help="JSON report (default: bench/results/eval_side_by_side.json, or "
+                                      "bench/results/eval_adapters.json with --compare)")
+    parser.add_argument("--compare", nargs=2, metavar=("OLD", "NEW"),
+                        help="two adapters, each run with the defaults on the suite, novel and dev sets")
+    parser.add_argument("--sets", default="suite,novel,dev",
+                        help=f"with --compare: which of {', '.join(SETS)} to run (default: all)")
+    parser.add_argument("--no-split", action="store_true", help="with --compare: whole tasks, no clause splitting")
     args = parser.parse_args()
+    if args.compare:
+        return compare(args.compare, [s.strip() for s in args.sets.split(",") if s.strip()], args.every,
+                       not args.no_split, args.out or "bench/results/eval_adapters.json")
+    args.out = args.out or "bench/results/eval_side_by_side.json"
 
     profile = load_profile()
     tasks = list(load_suite(args.suite, profile=profile))[:: max(1, args.every)]
@@ -70,6 +94,44 @@ def main() -> int:
         overall = run["table"]["overall"]
         print(f"{name:28s} accuracy {overall['accuracy']:.1%}  verified {overall['success']:.1%}  "
               f"p50 {overall['latency_p50_ms']:.0f} ms")
+    return 0
+
+
+def compare(adapters: list[str], sets: list[str], every: int, split: bool, out: str) -> int:
+    unknown = [name for name in sets if name not in SETS]
+    if unknown:
+        print(f"bench_eval: error: unknown set {', '.join(unknown)}; choose from {', '.join(SETS)}", file=sys.stderr)
+        return 2
+    profile = load_profile()
+    results: dict[str, dict[str, Any]] = {}
+    for adapter in adapters:
+        translator = Translator.load(profile, adapter=adapter, split_clauses=split)
+        for name in sets:
+            path = SETS[name]
+            tasks = list(load_suite(path, profile=profile))[:: max(1, every)]
+            started = time.perf_counter()
+            outcomes = run_suite(translator, tasks, profile)
+            table = summarize(outcomes)
+            entry: dict[str, Any] = {"suite": path or "agent/evalsuite/suite.toml", "tasks": len(tasks),
+                                     "wall_s": round(time.perf_counter() - started, 1), "table": table}
+            if not (path or "").startswith(FRESH):
+                entry["misses"] = [o.to_dict() for o in outcomes if not o.accepted]
+            results.setdefault(name, {})[adapter] = entry
+            print(f"\n{name}, adapter {adapter}\n{render_table(table)}", file=sys.stderr, flush=True)
+        translator.close()
+    report = {
+        "note": f"grammar on, clause splitting {'on' if split else 'off'}, every {every}. task",
+        "adapters": adapters,
+        "machine": f"{platform.machine()}, {os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f} at the end",
+        "sets": results,
+    }
+    Path(out).parent.mkdir(parents=True, exist_ok=True)
+    Path(out).write_text(json.dumps(report, indent=2) + "\n", encoding="utf-8")
+    for name, by_adapter in results.items():
+        for adapter, entry in by_adapter.items():
+            overall = entry["table"]["overall"]
+            print(f"{name:6s} {adapter:60s} accuracy {overall['accuracy']:.1%}  "
+                  f"p50 {overall['latency_p50_ms']:.0f} ms")
     return 0
 
 

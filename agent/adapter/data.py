@@ -24,6 +24,7 @@ from agent.adapter.prompt import adapter_prompt
 from agent.normalize import normalize_task
 from rsl.plan import Command, ObjectRef, Plan, Quantity, format_number
 from rsl.profile import Convention, Profile, Skill
+from rsl.syntax import NO_PROGRAM
 
 OBJECTS = (
     "cup", "mug", "bottle", "ball", "box", "book", "can", "apple", "banana", "orange", "phone",
@@ -59,57 +60,75 @@ PHRASES: dict[tuple[str, str], tuple[str, ...]] = {
         "move forward {a}", "go forward {a}", "drive forward {a}", "move ahead {a}", "go straight {a}",
         "drive straight ahead {a}", "advance {a}", "roll forward {a}", "head forward {a}", "move {a} forward",
         "go {a} forward", "drive {a} ahead", "move forward by {a}", "go ahead {a}", "drive {a}",
-        "move {a}", "go {a} straight ahead", "travel forward {a}", "walk forward {a}",
+        "move {a}", "go {a} straight ahead", "travel forward {a}", "walk forward {a}", "scoot forward {a}",
+        "step forward {a}", "proceed forward {a}", "go straight on {a}", "move the base forward {a}",
+        "drive ahead for {a}", "roll ahead {a}", "go on ahead {a}",
     ),
     ("drive", "back"): (
         "move backward {a}", "go back {a}", "drive backwards {a}", "back up {a}", "reverse {a}",
         "move back {a}", "retreat {a}", "drive backward by {a}", "go {a} backwards", "move {a} back",
-        "back up by {a}", "reverse {a} straight back", "roll back {a}", "step back {a}",
+        "back up by {a}", "reverse {a} straight back", "roll back {a}", "step back {a}", "back off {a}",
+        "go in reverse {a}", "move backwards {a}", "scoot back {a}", "drive in reverse for {a}",
     ),
     ("turn", "left"): (
         "turn left {a}", "rotate left {a}", "turn {a} to the left", "rotate {a} counterclockwise",
         "spin left {a}", "turn left by {a}", "rotate to the left by {a}", "turn counterclockwise {a}",
-        "make a left turn of {a}", "rotate {a} left", "turn to the left {a}",
+        "make a left turn of {a}", "rotate {a} left", "turn to the left {a}", "pivot left {a}",
+        "swing left {a}", "turn your body left {a}", "rotate the base left {a}", "turn yourself left {a}",
     ),
     ("turn", "right"): (
         "turn right {a}", "rotate right {a}", "turn {a} to the right", "rotate {a} clockwise",
         "spin right {a}", "turn right by {a}", "rotate to the right by {a}", "turn clockwise {a}",
-        "make a right turn of {a}", "rotate {a} right", "turn to the right {a}",
+        "make a right turn of {a}", "rotate {a} right", "turn to the right {a}", "pivot right {a}",
+        "swing right {a}", "turn your body right {a}", "rotate the base right {a}", "turn yourself right {a}",
     ),
     ("look", "up"): (
         "look up {a}", "tilt the head up {a}", "tilt the camera up {a}", "raise your head {a}",
-        "look upward {a}", "tilt up {a}", "look up by {a}", "aim the camera up {a}",
+        "look upward {a}", "tilt up {a}", "look up by {a}", "aim the camera up {a}", "tilt your head up {a}",
+        "point the camera up {a}", "glance up {a}", "move your head up {a}", "raise the camera {a}",
     ),
     ("look", "down"): (
         "look down {a}", "tilt the head down {a}", "tilt the camera down {a}", "lower your head {a}",
         "look downward {a}", "tilt down {a}", "look down by {a}", "aim the camera down {a}",
+        "tilt your head down {a}", "point the camera down {a}", "glance down {a}", "lower the camera {a}",
     ),
     ("look", "left"): (
         "look left {a}", "look to the left {a}", "pan the head left {a}", "turn your head left {a}",
-        "pan the camera to the left {a}", "pan left {a}", "look {a} to the left",
+        "pan the camera to the left {a}", "pan left {a}", "look {a} to the left", "glance left {a}",
+        "turn your head to the left {a}", "move the camera left {a}", "look over to the left {a}",
+        "swivel the camera left {a}", "point the camera left {a}",
     ),
     ("look", "right"): (
         "look right {a}", "look to the right {a}", "pan the head right {a}", "turn your head right {a}",
-        "pan the camera to the right {a}", "pan right {a}", "look {a} to the right",
+        "pan the camera to the right {a}", "pan right {a}", "look {a} to the right", "glance right {a}",
+        "turn your head to the right {a}", "move the camera right {a}", "look over to the right {a}",
+        "swivel the camera right {a}", "point the camera right {a}",
     ),
 }
 
 # Verb phrases for the same motions without an amount (the profile's default applies).
 BARE: dict[tuple[str, str], tuple[str, ...]] = {
     ("drive", "forward"): ("move forward", "go forward", "drive forward", "go straight", "move ahead",
-                           "drive ahead", "advance", "go straight ahead"),
-    ("drive", "back"): ("move backward", "go back", "back up", "reverse", "drive backwards", "move back"),
+                           "drive ahead", "advance", "go straight ahead", "scoot forward", "step forward",
+                           "go straight", "roll forward", "move the base forward"),
+    ("drive", "back"): ("move backward", "go back", "back up", "reverse", "drive backwards", "move back",
+                        "back off", "step back", "go in reverse"),
     ("turn", "left"): ("turn left", "rotate left", "turn to the left", "make a left turn", "spin left",
-                       "rotate counterclockwise", "take a left"),
+                       "rotate counterclockwise", "take a left", "face left", "pivot left", "turn your body left"),
     ("turn", "right"): ("turn right", "rotate right", "turn to the right", "make a right turn",
-                        "spin right", "rotate clockwise", "take a right"),
-    ("look", "up"): ("look up", "tilt the head up", "look upward", "tilt the camera up", "raise your head"),
+                        "spin right", "rotate clockwise", "take a right", "face right", "pivot right",
+                        "turn your body right"),
+    ("look", "up"): ("look up", "tilt the head up", "look upward", "tilt the camera up", "raise your head",
+                     "glance up", "tilt your head up", "point the camera up", "look at the ceiling"),
     ("look", "down"): ("look down", "tilt the head down", "look downward", "tilt the camera down",
-                       "lower your head", "look at the floor"),
+                       "lower your head", "look at the floor", "glance down", "tilt your head down",
+                       "point the camera down"),
     ("look", "left"): ("look left", "look to the left", "pan the head left", "turn your head left",
-                       "pan the camera left"),
+                       "pan the camera left", "glance left", "turn your head to the left", "glance to your left",
+                       "look to your left", "look over your left shoulder"),
     ("look", "right"): ("look right", "look to the right", "pan the head right", "turn your head right",
-                        "pan the camera right"),
+                        "pan the camera right", "glance right", "turn your head to the right",
+                        "glance to your right", "look to your right", "look over your right shoulder"),
 }
 
 # How amounts attach to a vague phrase such as "a little" ("{v}" is the phrase).
@@ -126,9 +145,11 @@ VAGUE: dict[tuple[str, str], tuple[str, ...]] = {
     ("look", "right"): ("look right {v}", "look {v} to the right", "pan right {v}"),
 }
 
-PERCEIVE = ("perceive", "look for objects", "scan the area", "scan the room", "detect objects",
-            "take a look", "see what is around", "observe the scene", "check what is in front of you",
-            "scan your surroundings", "detect what is there", "take a picture")
+# Scanning or surveying a whole room is the profile's "look around", not one perceive.
+PERCEIVE = ("perceive", "look for objects", "detect objects", "see what is in front of you",
+            "take a look", "observe the scene", "check what is in front of you",
+            "detect what is there", "take a picture", "take a photo",
+            "run object detection", "check what's there", "look at what is in front of you")
 SEARCH = ("find the {o}", "look for the {o}", "search for the {o}", "locate the {o}", "spot the {o}",
           "try to find the {o}", "search the area for the {o}", "scan for the {o}", "detect the {o}")
 APPROACH = ("approach the {o}", "go to the {o}", "move to the {o}", "drive up to the {o}", "go over to the {o}",
@@ -141,7 +162,9 @@ GRASP = ("grasp the {o}", "pick up the {o}", "grab the {o}", "take the {o}", "pi
 GRASP_IT = ("grasp it", "pick it up", "grab it", "take it", "get it", "hold it", "grip it", "lift it")
 GOTO = ("go to {x}, {y}", "go to position {x}, {y}", "move to the location {x}, {y}", "drive to x {x} y {y}",
         "navigate to coordinates {x}, {y}", "go to the coordinates {x} {y}", "move to x {x}, y {y}",
-        "drive to position {x} {y}", "go to location {x}, {y}", "travel to {x}, {y}", "head to {x}, {y}")
+        "drive to position {x} {y}", "go to location {x}, {y}", "travel to {x}, {y}", "head to {x}, {y}",
+        "go to the point {x}, {y}", "move to point {x} {y}", "drive to the spot {x}, {y}",
+        "go to x {x} and y {y}", "navigate to the point {x} {y}", "go to coordinate {x}, {y}")
 ORIGIN = ("go back to the start", "return to the origin", "return to where you started", "go home",
           "return home", "come back to the starting position", "go back to the origin", "head back to the start",
           "drive back to the starting position", "return to the start", "go back to where you began",
@@ -149,6 +172,66 @@ ORIGIN = ("go back to the start", "return to the origin", "return to where you s
 JOINERS = (", ", ", then ", " then ", " and ", " and then ", ". then ", ", after that ", ". next, ",
            " and after that ", ", and then ", ". ")
 FILLERS = ("uh", "um", "uhm", "er", "okay", "please", "hmm")
+
+
+# Sentence frames around a task: how people address, soften and close a request.
+OPENERS = ("robot, ", "hey robot, ", "okay robot, ", "robot ", "please ", "could you ", "can you please ",
+           "would you ", "i'd like you to ", "i want you to ", "i need you to ", "now ", "next, ", "alright, ",
+           "go ahead and ", "let's ", "maybe ", "i think you should ", "how about you ", "your task: ",
+           "thanks, now ", "ok so ", "so ", "right, ", "hey, ", "buddy, ", "listen, ", "when you're ready, ")
+CLOSERS = (", please", " please", ", thanks", ", thank you", " now", " for me", ", that's all",
+           " and that's it", ", ok?", " when you're ready", ", robot", " right away", " if you can")
+CORRECTIONS = (", no, {b}", ", sorry, {b}", ", i mean {b}", ", no wait, {b}", ", make that {b}",
+               ", actually {b}", ", oops, {b}", ", no sorry, {b}", " - no, {b}", ", or rather {b}")
+AFTER = ("after you {x}, {y}", "once you {x}, {y}", "{y} after you {x}", "{y}, but first {x}",
+         "before you {y}, {x}", "{y}, but before that {x}",
+         "first {x}, and when that's done {y}", "{x}, and once you're done {y}", "{x} and afterwards {y}",
+         "{x}; after that {y}", "{x} before you {y}", "begin with {x}, then {y}")
+NEGATED = {"drive": ("move", "drive anywhere", "move the base", "go anywhere", "drive", "move your wheels"),
+           "turn": ("turn", "rotate", "turn your body", "spin", "turn the base"),
+           "look": ("move your head", "look around", "move the camera", "tilt your head"),
+           "other": ("move", "go anywhere", "touch anything", "grab anything")}
+NEGATION_FRAMES = ("don't {n}, just {c}", "do not {n}, {c}", "{c}, but don't {n}", "{c} without moving otherwise",
+                   "no need to {n}, just {c}", "{c}, don't {n}", "don't {n}. {c}", "without {ing}, {c}",
+                   "{c} only, don't {n}", "i don't want you to {n}, just {c}")
+OBJECT_ADVERBS = (" gently", " carefully", " slowly", " quickly", " now", " for me", " please", " right away",
+                  " with care", " firmly", " softly", " if you can")
+NOT_TASKS = (
+    # questions
+    "what time is it", "what's the weather like", "how are you", "how are you doing today", "what can you do",
+    "what's your name", "are you ready", "can you hear me", "are you there", "what are you doing",
+    "where are you", "how far did you go", "how much battery do you have", "what did you see",
+    "where is the {o}", "is the {o} heavy", "what color is the {o}", "did you find the {o}",
+    "how far away is the {o}", "do you know where the {o} is", "why did you stop", "is that the {o}",
+    "how many {o}s are there", "what is in front of you", "which way is left", "how fast can you go",
+    "how big is this room", "who made you", "do you like the {o}", "is it raining", "what day is it",
+    "how long will that take", "did you hear that", "what's two plus two", "are you done",
+    # chit-chat and statements
+    "nice job", "good job robot", "well done", "good robot", "i'm tired", "it's cold in here",
+    "the {o} is on the table", "i dropped the {o}", "that was great", "you're doing fine", "interesting",
+    "i like your camera", "my name is sam", "this is my kitchen", "the {o} looks nice", "i'm back",
+    "never seen a robot like you", "what a mess", "i'll be right back", "that's funny", "oh no",
+    "the meeting is at three", "my phone is ringing", "it's a nice day", "i'm going to make coffee",
+    # thanks, closings, greetings
+    "thanks", "thank you", "thank you so much", "thanks a lot", "cheers", "much appreciated",
+    "that's all", "that's all for now", "we're done here", "cheers, we're done here", "that will be all",
+    "bye", "goodbye", "see you later", "good night", "talk to you later", "we're finished", "all done",
+    "that's it for today", "ok that's everything", "thanks, that's all", "you can rest now",
+    "hello", "hi", "hi robot", "hello robot", "good morning", "good afternoon", "hey there", "hey",
+    # skills this robot does not have
+    "sing a song", "tell me a joke", "make me a coffee", "call my mom", "play some music", "dance for me",
+    "jump", "fly up to the ceiling", "open the door", "close the window", "wash the {o}", "cook dinner",
+    "clean the floor", "turn on the lights", "turn off the tv", "order a pizza", "read me a book",
+    "throw the {o}", "open the {o}", "paint the {o}", "cut the {o}", "break the {o}", "eat the {o}",
+    "charge yourself", "send an email", "set an alarm", "climb the stairs", "swim", "speak louder",
+    "water the plants", "fold the laundry", "kick the {o}", "sweep the floor", "write a letter",
+    "translate this into french", "count to ten", "take out the trash", "make the bed", "feed the cat",
+    # pure negations and calls to wait
+    "don't move", "don't do anything", "do nothing", "never mind", "forget it", "cancel that",
+    "don't go anywhere", "don't touch the {o}", "don't pick up the {o}", "stay where you are", "stay still",
+    "hold still", "wait", "hold on a second", "don't turn", "no, don't do that", "stop", "not now",
+    "don't look", "leave the {o} alone", "ignore that", "scratch that", "nothing for now", "just wait there",
+)
 TIMES = {2: ("2 times", "two times", "twice"), 3: ("3 times", "three times", "thrice"),
          4: ("4 times", "four times", "for times"), 5: ("5 times", "five times"), 6: ("6 times", "six times")}
 POLYGONS = {3: ("triangle",), 4: ("square",), 5: ("pentagon",), 6: ("hexagon",)}
@@ -250,6 +333,12 @@ def _parse_program(text: str, profile: Profile) -> list[Command] | None:
 
     plan = compile_program(text, profile).plan
     return None if plan is None else list(plan)
+
+
+def _program_objects(program: str, profile: Profile) -> list[str]:
+    """The object names a convention's example program passes ("approach cup; grasp cup;" -> cup)."""
+    return [arg.name for command in _parse_program(program, profile) or () for arg in command.args
+            if isinstance(arg, ObjectRef)]
 
 
 @dataclass(frozen=True)
@@ -379,8 +468,10 @@ class Generator:
         if role is None:
             return None
         templates = {"approach": (APPROACH, APPROACH_IT), "grasp": (GRASP, GRASP_IT)}[kind]
-        text = self._pick(templates[1] if refer else templates[0])
-        return Clause(text.format(o=obj.replace("_", " ")), (self._cmd(role, obj),), obj)
+        text = self._pick(templates[1] if refer else templates[0]).format(o=obj.replace("_", " "))
+        if kind == "grasp" and self.rng.random() < 0.15:
+            text += self._pick(OBJECT_ADVERBS)  # "pick up the book gently": the adverb is no part of the name
+        return Clause(text, (self._cmd(role, obj),), obj)
 
     def perceive(self, obj: str | None = None) -> Clause | None:
         role = self.first.get("perceive")
@@ -414,7 +505,10 @@ class Generator:
     def whole_convention(self) -> Clause | None:
         if not self.whole:
             return None
-        convention = self.rng.choice(self.whole)
+        plain = [c for c in self.whole if not _program_objects(c.program, self.profile)]
+        if not plain:
+            return None
+        convention = self.rng.choice(plain)
         commands = _parse_program(convention.program, self.profile) or []
         text = self.rng.choice((convention.task, convention.phrase, convention.task))
         return Clause(text, tuple(commands))
@@ -497,6 +591,140 @@ class Generator:
                            f"{body_text}, repeat that {times}"))
         return text, [c for _ in range(count) for clause in body for c in clause.commands]
 
+    def _scoped_repetition(self) -> tuple[str, list[Command]] | None:
+        """Repetition forms whose scope people mark in many ways ("repeat X and Y 3 times")."""
+        if not self.by_motion:
+            return None
+        count = self.rng.choice((2, 2, 3, 3, 4, 5))
+        times = self._pick(TIMES[count])
+        r = self.rng.random()
+        if r < 0.35:
+            # "turn left 3 times 90 degrees": the count inside one clause.
+            role = self._motion_role()
+            key = (role.kind, role.direction)
+            if role.kind == "drive":
+                value = self._distance(role)
+                said = self._say_distance(value)
+            else:
+                degrees, value = self._angle(role)
+                said = self._say_angle(degrees, value)
+            template = self._pick([t for t in PHRASES[key] if t.endswith("{a}")])
+            text = self._pick((template.format(a=f"{times} {said}"), f"{times} {template.format(a=said)}",
+                               f"{template.format(a=said)}, {times} in a row"))
+            return text, [self._cmd(role, value)] * count
+        body = [self.motion(self._motion_role()) for _ in range(self.rng.choice((2, 2, 3)))]
+        body_text = self._join([c.text for c in body])
+        commands = [c for clause in body for c in clause.commands]
+        if r < 0.7:
+            text = self._pick((f"repeat {body_text} {times}", f"{times}: {body_text}",
+                               f"{times} in a row, {body_text}", f"{body_text}, all of that {times}",
+                               f"{body_text}, and repeat the whole thing {times}",
+                               f"{body_text}, {times} over", f"do {body_text}, {times}"))
+            return text, commands * count
+        # A step before the repeated part is not repeated.
+        before = self.simple()
+        text = self._pick((f"{before.text}, then repeat {body_text} {times}",
+                           f"{before.text}, then {times}: {body_text}",
+                           f"{before.text}, after that do {body_text} {times}"))
+        return text, list(before.commands) + commands * count
+
+    def correction(self) -> Clause:
+        """A self-correction: only what the speaker settles on counts ("1 meter, no, 2")."""
+        role = self._motion_role()
+        key = (role.kind, role.direction)
+        if role.kind in ("turn", "look") and self.rng.random() < 0.35:
+            other = {"left": "right", "right": "left", "up": "down", "down": "up"}[role.direction]
+            right = self.by_motion.get((role.kind, other))
+            if right is not None:
+                first = self._pick(BARE[key])
+                default = next((a for a in self.defaults if role.kind in a.kinds), None)
+                if default is not None and self.rng.random() < 0.5:
+                    # "turn left, sorry, right": the direction alone is corrected.
+                    text = first + self._pick(CORRECTIONS).format(b=other)
+                    return Clause(text, (self._cmd(right, default.value),))
+                fixed = self.motion(right, "any")
+                return Clause(first + self._pick(CORRECTIONS).format(b=fixed.text), fixed.commands)
+        if role.kind == "drive":
+            wrong, value = self._distance(role), self._distance(role)
+            said_wrong, said = self._say_distance(wrong), self._say_distance(value)
+        else:
+            wrong_deg, wrong = self._angle(role)
+            degrees, value = self._angle(role)
+            said_wrong, said = self._say_angle(wrong_deg, wrong), self._say_angle(degrees, value)
+        if wrong == value:
+            return Clause(self._pick(PHRASES[key]).format(a=said), (self._cmd(role, value),))
+        template = self._pick([t for t in PHRASES[key] if t.endswith("{a}")])
+        text = template.format(a=said_wrong) + self._pick(CORRECTIONS).format(b=said)
+        return Clause(text, (self._cmd(role, value),))
+
+    def object_correction(self) -> Clause | None:
+        kind = self.rng.choice(("approach", "grasp"))
+        wrong, obj = self.rng.sample(OBJECTS, 2)
+        clause = self.object_clause(kind, wrong, refer=False)
+        if clause is None:
+            return None
+        text = clause.text + self._pick(CORRECTIONS).format(b=f"the {obj}")
+        return Clause(text, (self._cmd(self.first[kind], obj),), obj)
+
+    def negated(self) -> Clause:
+        """"don't move, just look left": the negated part adds nothing."""
+        clause = self.simple()
+        kinds = {classify(skill).kind for c in clause.commands if (skill := self.profile.skill(c.skill))}
+        if kinds & {"approach", "goto"}:
+            options = ["look"]  # going somewhere drives and turns the base
+        elif kinds & {"look", "perceive", "grasp"}:
+            options = ["drive", "turn"]
+        else:
+            options = [k for k in ("turn", "look") if k not in kinds]
+        negated = self._pick(NEGATED[self.rng.choice(options)])
+        ing = negated.split()[0]
+        ing = (ing[:-1] if ing.endswith("e") and not ing.endswith("ee") else ing) + "ing"
+        ing = " ".join([ing, *negated.split()[1:]]).replace("spining", "spinning").replace("grabing", "grabbing")
+        frame = self._pick(NEGATION_FRAMES)
+        return Clause(frame.format(n=negated, c=clause.text, ing=ing), clause.commands)
+
+    def ordered(self) -> tuple[str, list[Command]]:
+        """Two steps said out of order: "before you X, Y", "Y after you X"."""
+        first, second = self.step(), self.step()
+        template = self._pick(AFTER)
+        return template.format(x=first.text, y=second.text), [*first.commands, *second.commands]
+
+    def activity(self) -> Clause | None:
+        """A whole-command convention about an object ("go get the mug"), with the object varied."""
+        named = [c for c in self.whole if _program_objects(c.program, self.profile)]
+        if not named:
+            return None
+        convention = self.rng.choice(named)
+        old = _program_objects(convention.program, self.profile)[0]
+        obj = self.rng.choice(OBJECTS)
+        text = re.sub(rf"\b{re.escape(old)}\b", obj, convention.task)
+        if self.rng.random() < 0.3:
+            text += self._pick(OBJECT_ADVERBS)
+        program = re.sub(rf"\b{re.escape(old)}\b", obj, convention.program)
+        return Clause(text, tuple(_parse_program(program, self.profile) or ()), obj)
+
+    def not_a_task(self) -> str:
+        text = self._pick(NOT_TASKS).format(o=self.rng.choice(OBJECTS))
+        r = self.rng.random()
+        if r < 0.25:
+            text = self._pick(("robot, ", "hey robot, ", "hey, ", "okay, ", "so ", "um ", "well, ")) + text
+        elif r < 0.4:
+            text = text + self._pick(("?", ", robot", " please", "!", "?", ", thanks"))
+        elif r < 0.5:
+            text = self._pick(NOT_TASKS).format(o=self.rng.choice(OBJECTS)) + ", " + text
+        return text
+
+    def _frame(self, text: str) -> str:
+        """A vocative, polite or hedged frame around a task, sometimes."""
+        r = self.rng.random()
+        if r < 0.3:
+            text = self._pick(OPENERS) + text
+        elif r < 0.42:
+            text = text + self._pick(CLOSERS)
+        elif r < 0.48:
+            text = self._pick(OPENERS) + text + self._pick(CLOSERS)
+        return text
+
     def _motion_role(self) -> Role:
         return self.rng.choice(list(self.by_motion.values()))
 
@@ -555,7 +783,50 @@ class Generator:
 
     # --- tasks ---------------------------------------------------------
     def task(self) -> tuple[str, list[Command], str]:
-        """One raw task, its commands and its group."""
+        """One raw task, its commands and its group ("refuse" when it has no program)."""
+        r = self.rng.random()
+        if r < 0.12:
+            return self._surface(self.not_a_task()), [], "refuse"
+        if r < 0.3:
+            text, commands, group = self._base_task()
+            return self._surface(self._frame(text)), commands, group
+        special = self._special_task()
+        if special is not None:
+            text, commands, group = special
+            return self._surface(self._frame(text) if self.rng.random() < 0.5 else text), commands, group
+        text, commands, group = self._base_task()
+        return self._surface(self._frame(text) if self.rng.random() < 0.3 else text), commands, group
+
+    def _special_task(self) -> tuple[str, list[Command], str] | None:
+        r = self.rng.random()
+        if r < 0.12:
+            clause = self.correction()
+            return clause.text, list(clause.commands), "correction"
+        if r < 0.16:
+            obj_clause = self.object_correction()
+            return (obj_clause.text, list(obj_clause.commands), "correction") if obj_clause else None
+        if r < 0.26:
+            clause = self.negated()
+            return clause.text, list(clause.commands), "negation"
+        if r < 0.38:
+            text, commands = self.ordered()
+            return text, commands, "multi-step"
+        if r < 0.5:
+            activity = self.activity()
+            if activity is None:
+                return None
+            if self.rng.random() < 0.3:
+                other = self.step()
+                text, commands = self._join([other.text, activity.text]), [*other.commands, *activity.commands]
+                return text, commands, "activity"
+            return activity.text, list(activity.commands), "activity"
+        if r < 0.62:
+            scoped = self._scoped_repetition()
+            return (scoped[0], scoped[1], "repetition") if scoped else None
+        return None
+
+    def _base_task(self) -> tuple[str, list[Command], str]:
+        """The plain task shapes: one step, vague amounts, conventions, sequences, fetching, repetition."""
         r = self.rng.random()
         if r < 0.3:
             clause = self.simple()
@@ -569,7 +840,7 @@ class Generator:
             clause = self.whole_convention() or self.simple()
             text, commands, group = clause.text, list(clause.commands), "ambiguous"
         elif r < 0.72:
-            clauses = [self.step() for _ in range(self.rng.choice((2, 2, 2, 3, 3, 4)))]
+            clauses = [self.step() for _ in range(self.rng.choice((2, 2, 2, 3, 3, 4, 4, 5)))]
             text = self._join([c.text for c in clauses])
             commands = [c for clause in clauses for c in clause.commands]
             group = "multi-step"
@@ -584,7 +855,7 @@ class Generator:
             repeated = self.repetition()
             if repeated is None:
                 clause = self.simple()
-                return self._surface(clause.text), list(clause.commands), "simple"
+                return clause.text, list(clause.commands), "simple"
             text, commands = repeated
             if self.rng.random() < 0.25:
                 extra = self.origin() if self.rng.random() < 0.5 else self.simple()
@@ -592,7 +863,7 @@ class Generator:
                     text = self._join([text, extra.text])
                     commands = commands + list(extra.commands)
             group = "complex"
-        return self._surface(text), commands, group
+        return text, commands, group
 
     def _surface(self, text: str) -> str:
         """Written or spoken surface form: capitals and a full stop, or ASR noise."""
@@ -614,16 +885,22 @@ class Generator:
                 raise RuntimeError(f"the generator could only make {len(out)} distinct pairs of {count} "
                                    f"asked for; ask for fewer")
             text, commands, group = self.task()
-            if not commands or len(commands) > self.profile.max_statements:
+            if (not commands and group != "refuse") or len(commands) > self.profile.max_statements:
                 continue
             normalized = normalize_task(text)
             if normalized in seen or (exclude is not None and exclude(normalized)):
                 continue
             seen.add(normalized)
-            program = Plan(tuple(commands), self.profile.name).to_rsl()
+            program = Plan(tuple(commands), self.profile.name).to_rsl() if commands else NO_PROGRAM + "\n"
             out.append(Pair(task=text, normalized=normalized, program=program, group=group,
                             prompt=adapter_prompt(normalized, self.profile)))
         return out
+
+
+# Words a speech recognizer writes for another word that sounds the same.
+_MISHEARD = {"right": ("write", "rite"), "forward": ("foreword", "forwards"), "meters": ("meter", "metres"),
+             "degrees": ("degree",), "grab": ("crab",), "turn": ("term",), "cup": ("cop",),
+             "look": ("luck",), "left": ("lift",), "the": ("a", "da"), "then": ("than", "and")}
 
 
 def asr_noise(text: str, rng: random.Random) -> str:
@@ -637,6 +914,8 @@ def asr_noise(text: str, rng: random.Random) -> str:
             word = rng.choice(("to", "too"))
         elif word in ("four", "4") and unitish and rng.random() < 0.5:
             word = "for"
+        elif word in _MISHEARD and rng.random() < 0.15:
+            word = rng.choice(_MISHEARD[word])
         # A speaker hesitates between words, not inside "2 meters".
         previous = out[-1] if out else ""
         if rng.random() < 0.06 and not (re.match(r"[\d.]+$", previous) or previous in _NUMBER_WORDS):
@@ -652,6 +931,8 @@ def check_programs(pairs: Iterable[Pair], profile: Profile) -> None:
     from rsl.compiler import compile_program
 
     for pair in pairs:
+        if pair.program.strip() == NO_PROGRAM:
+            continue
         result = compile_program(pair.program, profile)
         if not result.ok:
             details = "; ".join(d.brief() for d in result.diagnostics)

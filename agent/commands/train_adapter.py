@@ -45,6 +45,9 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--eval", type=int, default=60, metavar="N", dest="eval_pairs",
                         help="held-out synthetic pairs to score the adapter on with llama.cpp (default 60; "
                              "0 skips)")
+    parser.add_argument("--checkpoint-every", type=int, default=0, metavar="N",
+                        help="also write the adapter every N steps as OUT.stepN.gguf, for a learning curve "
+                             "(default 0: never)")
     parser.add_argument("--dump-data", metavar="FILE", help="also write the training pairs here as JSON lines")
     parser.set_defaults(func=_train)
 
@@ -102,7 +105,8 @@ def _train(args: argparse.Namespace) -> int:
     print(f"training with {threads} CPU thread(s)", file=sys.stderr)
 
     recipe = Recipe(steps=args.steps, batch=args.batch, learning_rate=args.lr, rank=args.rank,
-                    alpha=2.0 * args.rank, seed=args.seed, threads=threads)
+                    alpha=2.0 * args.rank, seed=args.seed, threads=threads,
+                    checkpoint_every=args.checkpoint_every)
     base_sha = sha256_of(base)
     try:
         result = train(pairs, base, out, recipe, metadata={

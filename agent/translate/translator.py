@@ -38,7 +38,7 @@ from agent.translate.result import Attempt, TranslationResult
 from rsl.compiler import compile_program
 from rsl.diagnostics import Code, Diagnostic
 from rsl.plan import Quantity, format_number
-from rsl.profile import Convention, Profile
+from rsl.profile import IDENTIFIER, Convention, Profile
 from rsl.syntax import NO_PROGRAM
 
 # What the loop does, for a person following along (`nrtrans translate -v`, or log_level = "debug").
@@ -260,7 +260,9 @@ class Translator:
         if not self.options.grammar:
             return None
         numbers = None
-        if self.options.narrow and not state.free_numbers:
+        # Numbers are narrowed per clause only: a whole task mixes said numbers with
+        # conventions and counts ("forward 1.5 m twice, then come back home" would pin goto to 1.5, 2).
+        if self.options.narrow and self.options.split_clauses and not state.free_numbers:
             # A clause that states its numbers means them; the conventions'
             # numbers are only for vague clauses. Polygon turns stay for both.
             said = _task_numbers(state.clause.text, self._units)
@@ -351,6 +353,12 @@ class Translator:
         """Object names the clause itself mentions (`the red cup` -> red_cup, cup)."""
         if not self.options.narrow:
             return None
+        if not self.options.split_clauses:
+            # A whole task: any word or pair of words it says may name an object; the model, not
+            # an adjective rule, decides which ("pick up the book gently" is `book`).
+            words = [w for w in re.findall(r"[a-z]+", text) if w not in _NOT_OBJECTS]
+            pairs = [f"{a}_{b}" for a, b in itertools.pairwise(words)]
+            return tuple(dict.fromkeys(w for w in (*words, *pairs) if IDENTIFIER.match(w))) or None
         names: list[str] = []
         for phrase in _OBJECT_PHRASE.findall(text):
             words = phrase.split()

@@ -7,6 +7,8 @@ import re
 import pytest
 
 from agent.adapter.data import (
+    NO_PROGRAM,
+    Generator,
     Pair,
     asr_noise,
     check_programs,
@@ -28,15 +30,20 @@ def pairs(profile: Profile):
 
 def test_every_program_compiles_and_is_canonical(pairs, profile: Profile) -> None:
     for pair in pairs:
+        if pair.group == "refuse":
+            assert pair.program == NO_PROGRAM + "\n"
+            continue
         result = compile_program(pair.program, profile)
         assert result.ok, (pair, result.diagnostics)
         assert result.plan is not None and result.plan.to_rsl() == pair.program
 
 
 def test_every_skill_and_group_is_covered(pairs, profile: Profile) -> None:
-    used = {line.split()[0].rstrip(";") for pair in pairs for line in pair.program.splitlines()}
+    used = {line.split()[0].rstrip(";") for pair in pairs for line in pair.program.splitlines()
+            if pair.group != "refuse"}
     assert used == set(profile.keywords)
-    assert {p.group for p in pairs} == {"simple", "ambiguous", "multi-step", "complex"}
+    assert {p.group for p in pairs} == {"simple", "ambiguous", "multi-step", "complex", "correction",
+                                        "negation", "repetition", "refuse"}
 
 
 def test_training_input_is_the_normalized_task(pairs) -> None:
@@ -51,7 +58,7 @@ def test_same_seed_same_data_other_seed_other_data(profile: Profile) -> None:
 
 def test_units_number_words_and_repetition_appear(pairs) -> None:
     tasks = " ".join(p.task.lower() for p in pairs)
-    for phrase in ("degrees", "centimeters", "half a meter", "times", "square", "triangle", "full circle",
+    for phrase in ("degrees", "centimeters", "half a met", "times", "square", "triangle", "full circle",
                    " it", "look around"):
         assert phrase in tasks, phrase
     assert re.search(r"\b(two|three|four|five|ten) (meters|metres|meter|m)\b", tasks)
@@ -102,7 +109,8 @@ params = [{ name = "width", kind = "number", unit = "m", min = 0.05, max = 0.5 }
     crawler = parse_profile(text)
     assert [classify(s).kind for s in crawler.skills] == ["drive", "turn", "perceive", "other"]
     data = generate(crawler, 300, seed=0)
-    keywords = {line.split()[0].rstrip(";") for p in data for line in p.program.splitlines()}
+    keywords = {line.split()[0].rstrip(";") for p in data for line in p.program.splitlines()
+                if p.group != "refuse"}
     assert keywords == {"crawl", "pivotleft", "beep", "paint"}
     # Ranges come from the profile: the crawler never crawls more than 3 m.
     assert all(float(line.split()[1].rstrip(";")) <= 3.0
@@ -148,3 +156,56 @@ def test_training_prompts_carry_the_notes(profile: Profile) -> None:
     assert noted and all(p.prompt == adapter_prompt(p.normalized, profile) for p in pairs)
     assert all("Note: look around = " in p.prompt for p in noted)
     assert load_profile().skill("forward") is not None
+
+
+def test_words_that_are_no_task_have_no_program(pairs) -> None:
+    refused = [p for p in pairs if p.group == "refuse"]
+    assert len(refused) > len(pairs) // 20
+    assert all(p.program == NO_PROGRAM + "\n" for p in refused)
+    assert NO_PROGRAM not in {p.program.strip() for p in pairs if p.group != "refuse"}
+
+
+def test_a_self_correction_keeps_only_what_was_settled_on(profile: Profile) -> None:
+    generator = Generator(profile, seed=5)
+    for _ in range(200):
+        clause = generator.correction()
+        numbers = re.findall(r"\d+(?:\.\d+)?", normalize_task(clause.text))
+        assert len(clause.commands) == 1
+        if numbers:
+            # The program carries the last amount said, as the normalizer converted it.
+            assert clause.commands[0].number() == float(numbers[-1]), clause
+
+
+# A whole-activity convention about an object, as docs/adapter.md proposes for the default profile.
+GO_GET = """
+[[conventions]]
+phrase = "go get"
+meaning = "approach the object, grasp it, then come back to the start (goto 0, 0)"
+task = "go get the cup"
+program = "approach cup; grasp cup; goto 0, 0;"
+
+"""
+
+
+def test_an_activity_convention_is_varied_in_its_object() -> None:
+    from rsl.profile import default_profile_path
+
+    with_activity = parse_profile(default_profile_path().read_text(encoding="utf-8") + GO_GET)
+    generator = Generator(with_activity, seed=2)
+    seen = set()
+    for _ in range(60):
+        clause = generator.activity()
+        assert clause is not None and clause.obj is not None
+        assert [c.skill for c in clause.commands] == ["approach", "grasp", "goto"]
+        assert all(c.args[0].name == clause.obj for c in clause.commands[:2])  # type: ignore[union-attr]
+        assert clause.obj.replace("_", " ") in clause.text
+        seen.add(clause.obj)
+    assert len(seen) > 10
+
+
+def test_a_negated_skill_is_not_in_the_program(profile: Profile) -> None:
+    generator = Generator(profile, seed=3)
+    for _ in range(200):
+        clause = generator.negated()
+        if clause.text.startswith("don't move, just "):
+            assert all(c.skill not in ("forward", "backward", "approach", "goto") for c in clause.commands)

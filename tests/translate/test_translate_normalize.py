@@ -33,6 +33,12 @@ from agent.normalize import normalize_task
         ("move forward 300 millimetres", "move forward 0.3 m"),
         ("drive to the point -2, 1.5", "drive to the point -2, 1.5"),
         ("drive point five meters", "drive 0.5 m"),
+        ("go to the point two, five", "go to the point 2, 5"),
+        ("do one complete rotation", "do 6.2832 rad"),
+        ("spin a whole turn", "spin 6.2832 rad"),
+        # Thanks and corrections carry meaning the model needs: a closing is no task, "i mean" corrects.
+        ("cheers, thanks, that's all", "cheers, thanks, that's all"),
+        ("turn left, i mean right", "turn left, i mean right"),
     ],
 )
 def test_normalize_converts_numbers_units_and_fillers(task: str, expected: str) -> None:
