@@ -53,6 +53,8 @@ class Skill:
     # The skill that moves the same way in reverse, named in diagnostics when
     # a negative value was written.
     opposite: str | None = None
+    # How explain-back says one statement, e.g. "drive forward {distance}"; empty: worded from `description`.
+    say: str = ""
 
     @property
     def signature(self) -> str:
@@ -245,4 +247,5 @@ def _skill(raw: dict[str, Any], index: int, workspace: dict[str, tuple[float, fl
     aliases = tuple(str(a).lower() for a in raw.get("aliases", []))
     return Skill(keyword=word, description=str(raw.get("description", "")),
                  example=str(raw.get("example", f"{word};")), params=tuple(params), aliases=aliases,
-                 opposite=raw.get("opposite"))
+                 opposite=raw.get("opposite"),
+                 say=str(raw.get("say", "")))
