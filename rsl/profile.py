@@ -55,6 +55,12 @@ class Skill:
     opposite: str | None = None
     # How explain-back says one statement, e.g. "drive forward {distance}"; empty: worded from `description`.
     say: str = ""
+    # A skill run first on this skill's object when the object is out of the arm's reach (`approach`).
+    out_of_reach: str | None = None
+    # How the skill moves the base, for checks before motion: `drives` is the bearing (degrees from where
+    # the robot faces) of a straight drive by its distance; `turns` +1 turns left by its angle, -1 right.
+    drives: float | None = None
+    turns: float | None = None
 
     @property
     def signature(self) -> str:
@@ -92,6 +98,7 @@ class Motion:
     reach: float = 0.8
     standoff: float = 0.5
     timeout_margin: float = 5.0
+    width: float = 0.4  # m, across the base: the corridor a straight drive sweeps
 
 
 @dataclass(frozen=True)
@@ -177,6 +184,8 @@ def _build(data: dict[str, Any], text: str, source: str) -> Profile:
     for skill in skills:
         if skill.opposite is not None and skill.opposite not in seen:
             raise fail(f"skill `{skill.keyword}`: opposite `{skill.opposite}` is not a skill")
+        if skill.out_of_reach is not None and skill.out_of_reach not in seen:
+            raise fail(f"skill `{skill.keyword}`: out_of_reach `{skill.out_of_reach}` is not a skill")
         for alias in skill.aliases:
             if alias in seen:
                 raise fail(f"alias `{alias}` of `{skill.keyword}` is itself a skill keyword")
@@ -248,4 +257,6 @@ def _skill(raw: dict[str, Any], index: int, workspace: dict[str, tuple[float, fl
     return Skill(keyword=word, description=str(raw.get("description", "")),
                  example=str(raw.get("example", f"{word};")), params=tuple(params), aliases=aliases,
                  opposite=raw.get("opposite"),
-                 say=str(raw.get("say", "")))
+                 say=str(raw.get("say", "")), out_of_reach=raw.get("out_of_reach"),
+                 drives=None if raw.get("drives") is None else float(raw["drives"]),
+                 turns=None if raw.get("turns") is None else float(raw["turns"]))

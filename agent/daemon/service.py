@@ -23,6 +23,7 @@ from agent.daemon.confirm import Question
 from agent.daemon.events import EventBus
 from agent.daemon.protocol import ProtocolError
 from agent.daemon.tasks import Busy, Peer, Task, TaskQueue, TaskState
+from agent.daemon.world_checks import check_world
 from agent.translate.confidence import UNSURE_BELOW
 from agent.translate.explain import capabilities, explain
 
@@ -353,6 +354,11 @@ class Service:
         plan = self._translate(task, known, start) if task.text is not None else self._compile(task, known, start)
         if plan is None:
             return
+        world = check_world(plan, self.profile, self.robot)
+        if world.plan is None:
+            self._reject(task, world.refusal, [])
+            return
+        plan = world.plan
         task.program = plan.to_rsl()
         task.plan = plan.to_list()
         task.explanation = explain(plan, self.profile)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import signal
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -14,16 +15,22 @@ from agent.client import Client, RequestFailed
 from tests.daemon.conftest import Daemon, check_frame, follow
 
 TIMEOUT_S = 3.0
-# Whatever the model writes for it, a plan for "pick it up" names an object nobody said, or does not
-# use the gripper that was asked for: the meaning checks doubt it, so the daemon asks.
-UNSURE = "pick it up"
+TASK = "drive forward 0.3 meters"
+# The shipped adapter writes a base turn for it (a plan the meaning checks doubt: "you said not to move
+# the base"); if a retrained adapter gets it right, pick another phrase it gets wrong.
+UNSURE = "don't move, just look left"
 NOT_A_TASK = "thank you, that is all for today"
+
+
+def _settings(policy: str) -> dict[str, dict[str, Any]]:
+    return {"translator": {"adapter": "default", "confirm": policy, "confirm_timeout": TIMEOUT_S},
+            "robot": {"realtime_factor": 0.0}}
 
 
 @pytest.fixture(scope="module")
 def daemon(module_workdir: Path) -> Iterator[Daemon]:
-    running = Daemon(module_workdir, {"translator": {"adapter": "default", "confirm": "unsure",
-                                                     "confirm_timeout": TIMEOUT_S}}).start()
+    # "always" asks whatever the model writes, so the waiting itself is tested apart from the model.
+    running = Daemon(module_workdir, _settings("always")).start()
     yield running
     assert running.stop() == 0, running.output()
 
@@ -50,34 +57,58 @@ def _until(client: Client, task: str, name: str) -> list[dict[str, Any]]:
     raise AssertionError(f"the task ended without a {name!r} event: {[e['event'] for e in seen]}")
 
 
-def _asked(client: Client) -> tuple[str, dict[str, Any], dict[str, float]]:
+def _asked(client: Client, text: str = TASK) -> tuple[str, dict[str, Any], dict[str, float]]:
     before = _pose(client)
-    task = client.submit(text=UNSURE, follow=True)
+    task = client.submit(text=text, follow=True)
     events = _until(client, task, "confirm")
     verified = next(e for e in events if e["event"] == "verified")
     question = events[-1]
     assert question["explanation"] == verified["explanation"] and question["explanation"]
-    assert question["confidence"] is not None and question["confidence"] < 0.5 and question["reasons"]
-    assert question["timeout_s"] == TIMEOUT_S and question["text"] == UNSURE
+    assert question["timeout_s"] == TIMEOUT_S and question["text"] == text
     assert client.status(task)["state"] == "confirming"
     return task, question, before
 
 
-def test_an_unsure_task_waits_for_confirm_then_runs(daemon: Daemon) -> None:
-    with daemon.client() as client:
-        task, _question, _before = _asked(client)
-        time.sleep(TIMEOUT_S / 2)
-        assert client.status(task)["state"] == "confirming", "it must not run before the answer"
-        reply = client.confirm(task, True)
-        assert reply["accepted"] is True
-        events = follow(client, task)
+def _accepted_and_run(client: Client, task: str, before: dict[str, float]) -> None:
+    time.sleep(TIMEOUT_S / 2)
+    assert client.status(task)["state"] == "confirming", "it must not run before the answer"
+    assert _pose(client) == before
+    reply = client.confirm(task, True)
+    assert reply["accepted"] is True
+    events = follow(client, task)
     names = [e["event"] for e in events]
     assert names[0] == "answered" and events[0]["by"] == f"uid {os.getuid()}" and events[0]["accepted"]
-    assert "executing" in names, names
+    assert "executing" in names and names[-1] == "done", names
+    assert _pose(client) != before
+    record = client.status(task)
+    assert record["confirmed_by"] == f"uid {os.getuid()}"
+    assert any(r["task"] == task and r["confirmed_by"] == f"uid {os.getuid()}" for r in client.history(50))
+
+
+def test_a_task_waits_for_confirm_then_runs(daemon: Daemon) -> None:
     with daemon.client() as client:
-        record = client.status(task)
-        assert record["confirmed_by"] == f"uid {os.getuid()}"
-        assert any(r["task"] == task and r["confirmed_by"] == f"uid {os.getuid()}" for r in client.history(50))
+        task, question, before = _asked(client)
+        assert question["explanation"] == "drive forward 30 cm"
+        _accepted_and_run(client, task, before)
+
+
+def test_under_the_default_policy_only_an_unsure_task_waits(daemon: Daemon) -> None:
+    text = daemon.config_file.read_text(encoding="utf-8").replace('confirm = "always"', 'confirm = "unsure"')
+    daemon.config_file.write_text(text, encoding="utf-8")
+    daemon.send_signal(signal.SIGHUP)
+    try:
+        time.sleep(2)
+        with daemon.client() as client:
+            task = client.submit(text=TASK, follow=True)
+            names = [e["event"] for e in follow(client, task)]
+            assert "confirm" not in names and names[-1] == "done", names
+            task, question, before = _asked(client, UNSURE)
+            assert question["confidence"] < 0.5 and question["reasons"], question
+            _accepted_and_run(client, task, before)
+    finally:
+        daemon.config_file.write_text(text.replace('confirm = "unsure"', 'confirm = "always"'), encoding="utf-8")
+        daemon.send_signal(signal.SIGHUP)
+        time.sleep(2)
 
 
 def test_a_declined_task_never_moves(daemon: Daemon) -> None:
