@@ -16,6 +16,7 @@ named below.
 
 from __future__ import annotations
 
+import itertools
 import math
 import re
 from collections.abc import Collection, Iterable
@@ -66,7 +67,7 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     text = task.lower()
     negated = " ".join(m.group(0) for m in _NEGATION.finditer(text))
     affirmed = _NEGATION.sub(" ", text)
-    words = set(_WORD.findall(affirmed))
+    words = _words(affirmed, vocab)
     doubts: list[Doubt] = []
     doubts += _parts(plan, vocab, words, set(_WORD.findall(negated)), text, profile)
     doubts += _directions(plan, vocab, words, profile)
@@ -74,6 +75,12 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     doubts += _totals(text, plan, vocab)
     doubts += _objects(text, plan, known_objects, vocab)
     return tuple({d.reason: d for d in doubts}.values())
+
+
+def _words(text: str, vocab: _Vocabulary) -> set[str]:
+    """The task's words, with a pair that spells a skill word joined: "back up" is `backup`, "pick up" `pickup`."""
+    tokens = _WORD.findall(text)
+    return set(tokens) | {a + b for a, b in itertools.pairwise(tokens) if a + b in vocab.skill_words}
 
 
 def skill_parts(profile: Profile) -> dict[str, str]:
@@ -321,7 +328,7 @@ def _objects(text: str, plan: Plan, known: Collection[str] | None, vocab: _Vocab
                                           "or an action"))
         elif not (set(name.lower().split("_")) & words):
             doubts.append(Doubt("object", f"the plan uses the {name.replace('_', ' ')}, which you did not mention"))
-    for name in sorted(known or ()):
+    for name in sorted(known or ()) if planned else ():
         parts = name.lower().split("_")
         if all(p in words for p in parts) and not any(set(parts) <= set(p.split("_")) for p in planned):
             doubts.append(Doubt("object", f"you mentioned the {name.replace('_', ' ')}, but the plan never uses it"))

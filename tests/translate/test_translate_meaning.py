@@ -90,7 +90,10 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     ("turn around", "turnleft 3.1416;"),
     ("turn left 90 degrees 3 times", "turnleft 1.5708; turnleft 1.5708; turnleft 1.5708;"),
     ("approach the table and pick up the cup", "approach table; grasp cup;"),
+    ("back up 0.7 meters", "backward 0.7;"),
+    ("look around and then find the keys",
+     "lookleft 1.5708; perceive; lookright 3.1416; perceive; lookleft 1.5708; perceive;"),
 ])
 def test_a_plan_that_does_what_was_said_has_no_doubt(task: str, program: str, profile: Profile) -> None:
-    assert reasons(task, program, profile, ["cup", "table"]) == []
+    assert reasons(task, program, profile, ["cup", "table", "keys"]) == []
     assert assess(normalize_task(task), plan(program, profile), profile, model=0.9).confidence == 0.9
