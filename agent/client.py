@@ -15,13 +15,14 @@ from __future__ import annotations
 
 import itertools
 import json
+import os
 import socket
 from collections import deque
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-from agent.daemon.config import default_socket_path
+from agent.daemon.config import ConfigError, config_path_from_env, load_config
 
 VERSION = 1
 TERMINAL_EVENTS = frozenset({"done", "failed", "cancelled", "rejected"})
@@ -43,6 +44,26 @@ class RequestFailed(ClientError):
         super().__init__(f"{self.code}: {self.message}")
 
 
+def find_socket(flag: str | Path | None = None, config_file: str | Path | None = None) -> Path:
+    """Where the daemon listens; `nrtrans serve` and every client command look in this order.
+
+    1. the `--socket PATH` flag;
+    2. `$NRTRANS_SOCKET`;
+    3. `api.socket` in the config file (`--config FILE`, else `$NRTRANS_CONFIG`);
+    4. the default, `nrtrans.sock` in the runtime directory (`$RUNTIME_DIRECTORY`, else
+       `$XDG_RUNTIME_DIR/nrtrans`, else `/run/nrtrans`).
+    """
+    if flag:
+        return Path(flag).expanduser()
+    if os.environ.get("NRTRANS_SOCKET"):
+        return Path(os.environ["NRTRANS_SOCKET"]).expanduser()
+    try:
+        config = load_config(config_path_from_env(str(config_file) if config_file else None))
+    except ConfigError as exc:
+        raise ClientError(f"cannot tell where the daemon listens: {exc}") from None
+    return config.socket_path()
+
+
 class Client:
     def __init__(self, sock: socket.socket, path: Path) -> None:
         self._sock = sock
@@ -52,8 +73,11 @@ class Client:
         self._pending: deque[dict[str, Any]] = deque()
 
     @classmethod
-    def connect(cls, path: str | Path | None = None, *, timeout: float | None = 10.0) -> Client:
-        socket_path = Path(path) if path else default_socket_path()
+    def connect(
+        cls, path: str | Path | None = None, *, timeout: float | None = 10.0, config_file: str | Path | None = None
+    ) -> Client:
+        """Connect to the socket at `path`, or the one `find_socket` names."""
+        socket_path = find_socket(path, config_file)
         sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
         sock.settimeout(timeout)
         try:
@@ -62,8 +86,8 @@ class Client:
             sock.close()
             raise ClientError(
                 f"no daemon socket at {socket_path}\n"
-                "  = help: start the daemon with `nrtrans serve`, or pass --socket PATH "
-                "(or set NRTRANS_SOCKET)"
+                "  = help: start the daemon with `nrtrans serve`, or point at its socket with --socket PATH, "
+                "$NRTRANS_SOCKET or api.socket in --config FILE ($NRTRANS_CONFIG), in that order"
             ) from None
         except PermissionError:
             sock.close()
@@ -192,7 +216,8 @@ def describe_event(event: dict[str, Any]) -> str:
     name = event["event"]
     prefix = f"[{event['task']}]" if event.get("task") else "[daemon]"
     if name == "queued":
-        detail = f"position {event['position']} in the queue"
+        ahead = event["position"]
+        detail = "next in line" if ahead == 0 else f"behind {ahead} other task{'s' if ahead > 1 else ''}"
     elif name in ("heard", "translating"):
         detail = repr(event["text"])
     elif name == "attempt":
@@ -223,9 +248,17 @@ def describe_event(event: dict[str, Any]) -> str:
             detail += f" ({outcome['reason']})"
     elif name == "done":
         pose = (event.get("state") or {}).get("pose")
-        detail = f"pose x={pose['x']:.2f} y={pose['y']:.2f} heading={pose['heading']:.2f}" if pose else ""
+        detail = (
+            f"pose x={_number(pose['x'])} y={_number(pose['y'])} heading={_number(pose['heading'])}" if pose else ""
+        )
     elif name == "speech":
         detail = str(event.get("state", ""))
     else:
         detail = str(event.get("reason", ""))
     return f"{prefix} {name} {detail}".rstrip()
+
+
+def _number(value: float) -> str:
+    """Two decimals, without the "-0.00" of a value that rounds to zero from below."""
+    text = f"{value:.2f}"
+    return "0.00" if text == "-0.00" else text

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 from agent.robot import CancelToken, Outcome, Pose, Robot, RobotState, Status
 from rsl.plan import Command, ObjectRef, Plan
-from rsl.profile import Profile
+from rsl.profile import Primitive, Profile, RosBinding, Skill
 
 log = logging.getLogger(__name__)
 
@@ -31,7 +31,7 @@ WATCHDOG_GRACE = 2.0
 class StepEvent:
     index: int  # 1-based
     total: int
-    statement: str  # canonical RSL, e.g. `forward 1.5;`
+    statement: str  # canonical RSL, e.g. `kw 1.5;`
     outcome: Outcome | None  # None: the step has just started
 
 
@@ -72,34 +72,45 @@ def drive_time(distance: float, profile: Profile) -> float:
 def step_timeout(command: Command, profile: Profile, start: RobotState | None = None) -> float:
     """The time budget of one step: its nominal duration at the profile's limits plus `timeout_margin`.
 
-    `goto` and `approach` depend on where the robot is; with `start` (the state
-    before the step) the budget uses the real distance, without it the
-    workspace's diagonal, which is always enough.
+    The budget follows the skill's binding, never its keyword. Navigating and
+    approaching depend on where the robot is; with `start` (the state before
+    the step) the budget uses the real distance, without it the workspace's
+    diagonal, which is always enough.
     """
     motion = profile.motion
     margin = motion.timeout_margin
     numbers = [a.value for a in command.args if not isinstance(a, ObjectRef)]
-    skill = command.skill
-    if skill in ("forward", "backward"):
+    skill = profile.skill(command.skill)
+    binding = skill.binding if skill is not None else None
+    primitive = binding.name if isinstance(binding, Primitive) else None
+    if primitive == "drive":
         return travel_time(numbers[0], motion.max_linear_speed, motion.max_linear_accel) + margin
-    if skill in ("turnleft", "turnright"):
+    if primitive == "turn":
         return travel_time(numbers[0], motion.max_angular_speed, motion.max_angular_accel) + margin
-    if skill.startswith("look"):
-        return sum(abs(n) for n in numbers) / motion.max_head_speed + margin
-    if skill == "goto" and len(numbers) == 2:
-        distance = (math.hypot(numbers[0] - start.pose.x, numbers[1] - start.pose.y) if start is not None
+    if primitive in ("pan", "tilt"):
+        return abs(numbers[0]) / motion.max_head_speed + margin
+    if primitive == "navigate" and skill is not None:
+        x, y = navigate_point(skill, numbers)
+        distance = (math.hypot(x - start.pose.x, y - start.pose.y) if start is not None
                     else _workspace_diagonal(profile))
         # A final turn-in-place may follow when the robot reverses onto the point.
         return drive_time(distance, profile) + margin
-    if skill == "approach":
+    if primitive == "approach_object":
         known = _distance_to_known(command.object(0), start.pose, start) if start is not None else None
         distance = known if known is not None else _workspace_diagonal(profile)
         # Two turns: to face the stand-off point, then to face the object.
         return drive_time(distance, profile) + travel_time(math.pi, motion.max_angular_speed,
                                                            motion.max_angular_accel) + margin
-    # perceive, grasp and skills this module does not know: the margin, plus a
-    # second per argument for skills that take some action on each.
-    return margin + 2.0 + len(command.args)
+    # perceive, grasp and ROS 2 bindings: the margin, plus a second per argument for skills
+    # that act on each, plus the time a joint trajectory is given to reach its point.
+    moving = binding.duration if isinstance(binding, RosBinding) else 0.0
+    return margin + 2.0 + len(command.args) + moving
+
+
+def navigate_point(skill: Skill, numbers: list[float]) -> tuple[float, float]:
+    """The (x, y) a `navigate` skill's arguments name, by each parameter's axis."""
+    by_axis = {p.axis: value for p, value in zip(skill.params, numbers, strict=True)}
+    return by_axis["x"], by_axis["y"]
 
 
 def _distance_to_known(name: str, pose: Pose, state: RobotState) -> float | None:
@@ -109,8 +120,8 @@ def _distance_to_known(name: str, pose: Pose, state: RobotState) -> float | None
     return None
 
 
-def _arguments(command: Command) -> list[float | str]:
-    return [a.name if isinstance(a, ObjectRef) else a.value for a in command.args]
+def _arguments(command: Command) -> tuple[float | str, ...]:
+    return tuple(a.name if isinstance(a, ObjectRef) else a.value for a in command.args)
 
 
 def _state(robot: Robot) -> RobotState | None:
@@ -160,11 +171,13 @@ def execute(plan: Plan, robot: Robot, profile: Profile, *, cancel: CancelToken |
 
 def _run_step(command: Command, statement: str, robot: Robot, profile: Profile,
               cancel: CancelToken) -> Outcome:
-    skill = getattr(robot, command.skill, None)
-    if not callable(skill):
-        return Outcome.failed(f"`{statement}` cannot run: the {_backend_name(robot)} backend has no skill "
-                              f"`{command.skill}`. Use a profile that matches this robot, or a backend "
-                              "that implements the skill")
+    skill = profile.skill(command.skill)
+    if skill is None or skill.binding is None:
+        why = (f"profile {profile.name} has no skill `{command.skill}`" if skill is None
+               else f"the skill `{command.skill}` declares no binding in profile {profile.name}")
+        return Outcome.failed(f"`{statement}` cannot run: {why}, so no backend knows what it does. "
+                              "Give it a `binding` (a robot primitive or a ROS 2 topic, service or "
+                              "joint trajectory; docs/skills.md)")
     budget = step_timeout(command, profile, _state(robot))
     # Wall-clock watchdog; a simulator slower than real time stretches it.
     scale = float(getattr(robot, "timeout_scale", 1.0))
@@ -189,7 +202,7 @@ def _run_step(command: Command, statement: str, robot: Robot, profile: Profile,
     relay.start()
     watchdog.start()
     try:
-        outcome = skill(*_arguments(command), cancel=step_token)
+        outcome = robot.perform(skill, _arguments(command), cancel=step_token)
     except Exception as exc:
         robot.stop()
         outcome = Outcome.failed(f"`{statement}` failed inside the {_backend_name(robot)} backend: "

@@ -4,10 +4,10 @@ Written into the directory:
 
 - `trajectory.png`: a top-down plot of the path, the objects, and where each
   step ended;
-- `step_NN_<skill>.png`: what the head camera saw at the end of each step
-  (simulator only);
-- `run.gif` with `gif=True`: an animation from a camera following the robot
-  (simulator only).
+- `step_NN_<skill>.png`: what the head camera saw at the end of each step,
+  aimed at the object when the step names one (simulator only);
+- `run.gif` with `gif=True`: an animation from a camera following the robot,
+  each frame captioned with the step it shows (simulator only).
 
 With the simulator every physics step is on record; with another backend the
 plot has the poses the robot reported at the start and at each step's end.
@@ -16,6 +16,7 @@ plot has the poses the robot reported at the start and at each step's end.
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -27,6 +28,8 @@ TRACE_EVERY = 4  # physics steps between trajectory points (30 Hz at 120 Hz phys
 GIF_PERIOD = 0.2  # s of simulated time between animation frames
 GIF_SIZE = (320, 240)
 GIF_MAX_FRAMES = 300  # beyond this the animation keeps every other frame, so memory stays bounded
+SAME_PLACE = 0.08  # m: steps that ended closer than this share one label on the plot
+LABEL_GAP = 2.0  # pixels kept free between two labels on the plot
 
 
 @dataclass(frozen=True)
@@ -52,6 +55,8 @@ class Recorder:
         self.marks: list[StepMark] = []
         self.snapshots: list[Path] = []
         self._frames: list[Any] = []
+        self._caption = "start"
+        self._font: Any = None
         self._ticks = 0
         self._next_frame = 0.0
         self._period = GIF_PERIOD
@@ -61,7 +66,7 @@ class Recorder:
         if self.world is not None:
             self.world.add_listener(self._on_physics)
             if self.gif:
-                self._frames.append(self.world.overview_image(*GIF_SIZE))
+                self._frames.append(self._captioned(self.world.overview_image(*GIF_SIZE)))
                 self._next_frame = self.world.sim_time + GIF_PERIOD
 
     def _on_physics(self, world: Any) -> None:
@@ -71,14 +76,16 @@ class Recorder:
             self.path.append((sample.x, sample.y))
         if self.gif and world.sim_time >= self._next_frame:
             self._next_frame = world.sim_time + self._period
-            self._frames.append(world.overview_image(*GIF_SIZE))
+            self._frames.append(self._captioned(world.overview_image(*GIF_SIZE)))
             if len(self._frames) > GIF_MAX_FRAMES:
                 self._frames = self._frames[::2]
                 self._period *= 2
 
     def on_event(self, event: StepEvent) -> None:
         if event.outcome is None:
+            self._caption = f"{event.index}/{event.total} {event.statement}"
             return
+        self._caption = f"{event.index}/{event.total} {event.statement} {event.outcome.status.value}"
         pose = self.robot.state().pose
         if self.world is None:
             self.path.append((pose.x, pose.y))
@@ -89,8 +96,32 @@ class Recorder:
 
             skill = event.statement.split()[0].rstrip(";")
             path = self.directory / f"step_{event.index:02d}_{skill}.png"
-            Image.fromarray(self.world.camera_image()).save(path)
+            Image.fromarray(self.world.camera_image(look_at=self._named_object(event.statement))).save(path)
             self.snapshots.append(path)
+
+    def _named_object(self, statement: str) -> tuple[float, float, float] | None:
+        """Where the first scene object the statement names is, so its snapshot can show it."""
+        positions = self.world.objects()
+        for word in re.findall(r"[A-Za-z_]\w*", statement):
+            if word in positions:
+                return positions[word]
+        return None
+
+    def _captioned(self, frame: Any) -> Any:
+        """The frame with the step it shows written across its bottom."""
+        from PIL import Image, ImageDraw, ImageFont
+
+        if self._font is None:
+            try:
+                self._font = ImageFont.load_default(size=13)
+            except (TypeError, OSError):  # Pillow without FreeType: the small bitmap font
+                self._font = ImageFont.load_default()
+        image = Image.fromarray(frame)
+        draw = ImageDraw.Draw(image)
+        height = image.height
+        draw.rectangle((0, height - 20, image.width, height), fill=(0, 0, 0))
+        draw.text((4, height - 18), self._caption, fill=(255, 255, 255), font=self._font)
+        return image
 
     def finish(self, result: ExecutionResult | None = None, title: str = "") -> list[Path]:
         """Write the pictures; returns their paths (the plot first)."""
@@ -123,6 +154,7 @@ class Recorder:
         from matplotlib.transforms import Affine2D
 
         figure, axes = plt.subplots(figsize=(8, 8), dpi=100)
+        labels: list[tuple[str, float, float, str, int]] = []
         holding = result.final_state.holding if result is not None and result.final_state is not None else None
         for obj in self._objects(result):
             sx, sy = obj["size"][0], obj["size"][1]
@@ -138,15 +170,14 @@ class Recorder:
             if moved:
                 axes.plot([obj["start"][0], obj["x"]], [obj["start"][1], obj["y"]], ":", color=obj["color"])
             label = obj["name"] + (" (held)" if obj["name"] == holding else "")
-            axes.annotate(label, (obj["x"], obj["y"]), textcoords="offset points", xytext=(6, 6), fontsize=9)
+            labels.append((label, obj["x"], obj["y"], "black", 9))
         xs, ys = zip(*self.path, strict=True)
         axes.plot(xs, ys, "-", color="tab:blue", linewidth=2, label="robot path")
         self._arrow(axes, FancyArrow, *self.start, "tab:green", "start")
-        for mark in self.marks:
-            color = {"done": "tab:blue", "failed": "tab:red", "cancelled": "tab:orange"}[mark.status]
-            axes.plot(mark.x, mark.y, "o", color=color, markersize=5)
-            axes.annotate(str(mark.index), (mark.x, mark.y), textcoords="offset points", xytext=(-10, -12),
-                          fontsize=8, color=color)
+        for place in _places(self.marks):
+            color = {"done": "tab:blue", "failed": "tab:red", "cancelled": "tab:orange"}[place.status]
+            axes.plot(place.x, place.y, "o", color=color, markersize=5)
+            labels.append((place.text, place.x, place.y, color, 8))
         if self.marks:
             last = self.marks[-1]
             self._arrow(axes, FancyArrow, last.x, last.y, last.heading, "tab:purple", "end")
@@ -161,7 +192,8 @@ class Recorder:
         if legend:
             axes.text(1.02, 1.0, "\n".join(legend[-40:]), transform=axes.transAxes, fontsize=8,
                       family="monospace", va="top")
-        axes.legend(loc="upper right", fontsize=8)
+        key = axes.legend(loc="upper right", fontsize=8)
+        _place_labels(figure, axes, labels, avoid=[key])
         path = self.directory / "trajectory.png"
         figure.savefig(path, bbox_inches="tight")
         plt.close(figure)
@@ -182,9 +214,84 @@ class Recorder:
         axes.set_ylim(low_y, high_y)
 
     def _animation(self) -> Path:
-        from PIL import Image
-
         path = self.directory / "run.gif"
-        frames = [Image.fromarray(f) for f in self._frames]
+        frames = self._frames
         frames[0].save(path, save_all=True, append_images=frames[1:], duration=int(self._period * 1000), loop=0)
         return path
+
+
+@dataclass(frozen=True)
+class Place:
+    """Where one or more steps ended, labelled with their numbers ("1, 2", "9-13, 16")."""
+
+    text: str
+    x: float
+    y: float
+    status: str  # the worst of the steps that ended here
+
+
+def _places(marks: list[StepMark]) -> list[Place]:
+    groups: list[list[StepMark]] = []
+    for mark in marks:
+        for group in groups:
+            if math.dist((group[0].x, group[0].y), (mark.x, mark.y)) < SAME_PLACE:
+                group.append(mark)
+                break
+        else:
+            groups.append([mark])
+    places = []
+    for group in groups:
+        statuses = {m.status for m in group}
+        status = next((s for s in ("failed", "cancelled") if s in statuses), "done")
+        places.append(Place(_numbers([m.index for m in group]), group[0].x, group[0].y, status))
+    return places
+
+
+def _numbers(indices: list[int]) -> str:
+    """`[1, 2, 9, 10, 11, 16]` -> "1, 2, 9-11, 16": runs of three or more collapse."""
+    runs: list[list[int]] = []
+    for index in indices:
+        if runs and index == runs[-1][-1] + 1:
+            runs[-1].append(index)
+        else:
+            runs.append([index])
+    parts = []
+    for run in runs:
+        parts.extend([f"{run[0]}-{run[-1]}"] if len(run) >= 3 else [str(i) for i in run])
+    return ", ".join(parts)
+
+
+# Offsets (points) and alignments tried in turn for a label, nearest first.
+_SPOTS = [(dx * far, dy * far, ha, va) for far in (1.0, 2.5, 4.5) for dx, dy, ha, va in (
+    (6, 6, "left", "bottom"), (6, -6, "left", "top"), (-6, 6, "right", "bottom"), (-6, -6, "right", "top"),
+    (8, 0, "left", "center"), (-8, 0, "right", "center"), (0, 8, "center", "bottom"), (0, -8, "center", "top"))]
+
+
+def _place_labels(figure: Any, axes: Any, labels: list[tuple[str, float, float, str, int]], avoid: list[Any]) -> None:
+    """Annotate each point, choosing for each label the nearest spot where it overlaps no earlier one."""
+    figure.canvas.draw()  # the layout is final, so the labels' extents are what will be saved
+    renderer = figure.canvas.get_renderer()
+    taken = [artist.get_window_extent(renderer) for artist in avoid]
+    for text, x, y, color, size in labels:
+        best: tuple[float, Any, Any] | None = None
+        for dx, dy, ha, va in _SPOTS:
+            note = axes.annotate(text, (x, y), textcoords="offset points", xytext=(dx, dy), ha=ha, va=va,
+                                 fontsize=size, color=color)
+            box = note.get_window_extent(renderer).padded(LABEL_GAP)
+            overlap = sum(_overlap(box, other) for other in taken)
+            if best is None or overlap < best[0]:
+                if best is not None:
+                    best[1].remove()
+                best = (overlap, note, box)
+            else:
+                note.remove()
+            if overlap == 0:
+                break
+        assert best is not None
+        taken.append(best[2])
+
+
+def _overlap(a: Any, b: Any) -> float:
+    width = min(a.x1, b.x1) - max(a.x0, b.x0)
+    height = min(a.y1, b.y1) - max(a.y0, b.y0)
+    return width * height if width > 0 and height > 0 else 0.0

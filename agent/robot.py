@@ -1,10 +1,11 @@
 """The one robot interface every backend (simulator, ROS 2) implements.
 
-A backend has one method per skill in the robot profile, named after the
-skill's keyword, taking the statement's arguments in order (floats for
-numbers, str for objects) plus a keyword-only `cancel` token, and returning
-an `Outcome`. Skills are data, so a backend is looked up by keyword at run
-time rather than through a fixed list of abstract methods.
+A backend runs a skill by its binding (`perform`): one of the robot
+primitives of `rsl.profile.PRIMITIVES` with its sign, or a ROS 2 binding. It
+never looks at the skill's keyword, so a profile may call its skills anything.
+Arguments come in the statement's order: floats for numbers, str for objects.
+For convenience (tests, generated Python) a backend also answers
+`robot.<keyword>(*args, cancel=...)` for every skill of its profile.
 """
 
 from __future__ import annotations
@@ -13,6 +14,8 @@ import threading
 from dataclasses import dataclass, field
 from enum import Enum
 from typing import Protocol, runtime_checkable
+
+from rsl.profile import Profile, Skill
 
 
 class Status(Enum):
@@ -89,9 +92,19 @@ class CancelToken:
         return self._event.wait(timeout)
 
 
+def approach_first(profile: Profile, name: str) -> str:
+    """Advice for an object out of reach, in this profile's words."""
+    skill = profile.bound_to("approach_object")
+    return f"`{skill.keyword} {name};` first" if skill is not None else f"drive closer to {name} first"
+
+
 @runtime_checkable
 class Robot(Protocol):
-    """Skill methods are looked up by keyword: `getattr(robot, command.skill)`."""
+    """What the executor drives; a step is `perform(skill, args, cancel=...)`."""
+
+    def perform(self, skill: Skill, args: tuple[float | str, ...], *,
+                cancel: CancelToken | None = None) -> Outcome:
+        """Run one step of `skill` (its binding says what to do) and say how it ended."""
 
     def stop(self) -> None:
         """Immediately command zero velocity and hold position."""

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import unicodedata
 from collections.abc import Collection
 from dataclasses import dataclass
 
@@ -17,6 +18,7 @@ from rsl.diagnostics import Code, Diagnostic
 from rsl.lexer import Kind, SourceMap, Token, tokenize
 from rsl.plan import Arg, Command, ObjectRef, Plan, Quantity
 from rsl.profile import Param, Profile, Skill
+from rsl.syntax import is_identifier
 
 
 @dataclass(frozen=True)
@@ -175,15 +177,10 @@ class _Compiler:
 
     def argument(self, statement: _Statement, skill: Skill, token: Token, param: Param) -> Arg | None:
         if token.kind is Kind.BAD_NUMBER:
-            self.flag(statement, Code.ILLEGAL_NUMBER, token,
-                      f"`{token.text}` is not a number; write a plain decimal such as "
-                      f"`{self.number_hint(token.text)}` (no units, one decimal point)")
+            self.flag(statement, Code.ILLEGAL_NUMBER, token, self.bad_number_message(token.text))
             return None
         if token.kind is Kind.BAD_IDENT:
-            fixed = token.text.lstrip("0123456789") or "object"
-            self.flag(statement, Code.ILLEGAL_IDENTIFIER, token,
-                      f"`{token.text}` is not a valid name: names start with a letter or `_`; "
-                      f"did you mean `{fixed}`?")
+            self.flag(statement, Code.ILLEGAL_IDENTIFIER, token, self.bad_name_message(token.text))
             return None
         if param.kind == "number":
             if token.kind is not Kind.NUMBER:
@@ -290,6 +287,32 @@ class _Compiler:
         kinds = ["an object" if p.kind == "object" else "a number" for p in skill.params]
         count = len(kinds)
         return f"{count} argument{'s' if count > 1 else ''} ({', '.join(kinds)})"
+
+    def bad_number_message(self, text: str) -> str:
+        sign, digits = ("-" if text.startswith("-") else ""), text.lstrip("-+")
+        base = {"x": 16, "b": 2, "o": 8}.get(digits[1:2].lower()) if digits.startswith("0") else None
+        if base is not None:
+            kind = {16: "hexadecimal", 2: "binary", 8: "octal"}[base]
+            try:
+                decimal = f"write it in decimal, `{sign}{int(digits[2:], base)}`"
+            except ValueError:
+                decimal = "write it as a plain decimal"
+            return f"`{text}` is not an RSL number: RSL has no C {kind} numbers; {decimal}"
+        if digits[:1] == "0" and digits.isdigit():
+            return (f"`{text}` is not an RSL number: a leading 0 makes it octal in C, which RSL does not have; "
+                    f"write `{sign}{digits.lstrip('0') or '0'}`")
+        return (f"`{text}` is not a number; write a plain decimal such as "
+                f"`{self.number_hint(text)}` (no units, one decimal point)")
+
+    @staticmethod
+    def bad_name_message(text: str) -> str:
+        if text.isascii():
+            fixed = text.lstrip("0123456789") or "object"
+            return f"`{text}` is not a valid name: names start with a letter or `_`; did you mean `{fixed}`?"
+        # NFKD splits `é` into `e` and an accent and turns `²` into `2`; what is left over is dropped.
+        fixed = "".join(c for c in unicodedata.normalize("NFKD", text) if c.isascii() and (c.isalnum() or c == "_"))
+        advice = f"write `{fixed}` instead" if is_identifier(fixed) else "use an ASCII name"
+        return f"`{text}` is not a valid name: names use only ASCII letters, digits and `_`; {advice}"
 
     @staticmethod
     def number_hint(text: str) -> str:

@@ -42,12 +42,20 @@ def language_description(profile: Profile) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _coordinates(profile: Profile) -> str:
+    takes = [f"`{s.keyword}`" for s in profile.skills if any(p.is_coordinate for p in s.params)]
+    if not takes:
+        return "and none may be zero or negative."
+    return f"only {' and '.join(takes)} coordinates may be zero or negative."
+
+
 def markdown_reference(profile: Profile) -> str:
     """docs/language.md: the reference for people, from the same source."""
     rows = []
     for skill in profile.skills:
         params = "; ".join(_param_text(p) for p in skill.params) or "none"
-        rows.append(f"| `{skill.signature}` | {skill.description} | {params} | `{skill.example}` |")
+        does = skill.binding.describe() if skill.binding is not None else "no binding: runs on no robot"
+        rows.append(f"| `{skill.signature}` | {skill.description} | {params} | {does} | `{skill.example}` |")
     conventions = [f"| {c.phrase} | {c.meaning} | `{c.program}` |" for c in profile.conventions]
     ws = profile.workspace
     return "\n".join([
@@ -62,12 +70,16 @@ def markdown_reference(profile: Profile) -> str:
         "",
         "Each statement is a lowercase command, its arguments separated by `,`, and `;`. "
         "Whitespace and newlines are free. Comments are `// to the end of the line` and `/* blocks */`. "
-        "Numbers are C-style decimals (`2`, `0.5`, `.5`, `1e-1`); amounts must be positive, "
-        "only `goto` coordinates may be zero or negative. Object names are C identifiers.",
+        "Numbers are C-style decimals (`2`, `0.5`, `.5`, `1e-1`), not C's hexadecimal `0x10` or octal `010`; "
+        f"amounts must be positive, {_coordinates(profile)} "
+        "Object names are ASCII C identifiers (letters, digits and `_`).",
         "",
-        "| statement | what it does | parameters | example |",
-        "|---|---|---|---|",
+        "| statement | what it does | parameters | binding | example |",
+        "|---|---|---|---|---|",
         *rows,
+        "",
+        "The binding is what the statement makes the robot do: a robot primitive that every backend "
+        "implements, or a ROS 2 topic, service or joint trajectory (docs/skills.md).",
         "",
         "## Limits",
         "",

@@ -1,76 +1,84 @@
-"""Export the profile's RSL as a llama.cpp GBNF grammar for constrained sampling.
+"""Write RSL's canonical language (`rsl.syntax`) as a llama.cpp GBNF grammar for constrained sampling.
 
-The grammar accepts exactly the canonical spelling the translator emits
-(`Plan.to_rsl()`): one `keyword arg, arg;` per line, numbers as plain
-decimals, and a final blank line. Ending on a blank line gives the model a
-natural way to stop, since "\\n\\n" is a single token in most vocabularies
-and the grammar must be able to accept it. Every program the grammar
-accepts also parses; value ranges, the workspace and object knowledge stay
-the compiler's job, which is why the repair loop exists.
+This is the only GBNF writer: the `nrtrans grammar` export, the decoding
+automaton's grammar for OpenAI-compatible endpoints and the tests all use it.
+Every program the grammar accepts also parses; value ranges, the workspace and
+object knowledge stay the compiler's job, which is why the repair loop exists.
 """
 
 from __future__ import annotations
 
-import math
-from collections.abc import Sequence
+from collections.abc import Collection, Mapping, Sequence
 
-from rsl.profile import IDENTIFIER, Param, Profile, Skill
+from rsl.profile import Profile
+from rsl.syntax import (
+    ARGUMENT_SEPARATOR,
+    KEYWORD_GAP,
+    LINE_END,
+    MAX_FRACTION_DIGITS,
+    MAX_IDENTIFIER,
+    NO_PROGRAM,
+    PROGRAM_END,
+    TERMINATOR,
+    Argument,
+    NumberShape,
+    ObjectShape,
+    Syntax,
+    syntax_of,
+)
 
-MAX_FRACTION_DIGITS = 4
+__all__ = ["MAX_FRACTION_DIGITS", "gbnf", "to_gbnf"]
 
 
-def to_gbnf(profile: Profile, objects: Sequence[str] | None = None) -> str:
-    """The grammar; `objects` narrows object arguments to those names.
+def to_gbnf(profile: Profile, objects: Sequence[str] | None = None, *, keywords: Collection[str] | None = None,
+            numbers: Mapping[str, Collection[str]] | None = None, max_statements: int | None = None,
+            refusal: bool = False) -> str:
+    """The grammar of `profile`, narrowed as `rsl.syntax.syntax_of` describes."""
+    return gbnf(syntax_of(profile, keywords=keywords, objects=objects, numbers=numbers,
+                          max_statements=max_statements, refusal=refusal))
 
-    With an empty `objects` list, skills that need an object are left out,
-    since no valid statement could use them.
-    """
-    if objects is not None:
-        bad = [name for name in objects if not IDENTIFIER.match(name)]
-        if bad:
-            raise ValueError(f"object names must be C identifiers: {', '.join(map(repr, bad))}")
-    skills = [s for s in profile.skills
-              if objects or objects is None or all(p.kind != "object" for p in s.params)]
+
+def gbnf(syntax: Syntax) -> str:
     rules: dict[str, str] = {}
-    statement_rules = []
-    for skill in skills:
-        name = f"skill-{skill.keyword.replace('_', '-')}"
-        rules[name] = _statement(skill, rules, profile)
-        statement_rules.append(name)
-    if any(p.kind == "object" for s in skills for p in s.params):
-        rules["object"] = _object_rule(objects)
-    lines = [
-        f"root ::= statement{{1,{profile.max_statements}}} \"\\n\"",
-        f"statement ::= ({' | '.join(statement_rules)}) \"\\n\"",
-    ]
+    names: dict[str, str] = {}  # rule body -> its name, so equal argument shapes share one rule
+    alternatives = []
+    for statement in syntax.statements:
+        if not statement.args:
+            alternatives.append(_literal(statement.keyword + TERMINATOR))
+            continue
+        parts = [_argument(arg, f"{statement.keyword}-{i}", rules, names) for i, arg in enumerate(statement.args)]
+        alternatives.append(_literal(statement.keyword + KEYWORD_GAP) + " "
+                            + f" {_literal(ARGUMENT_SEPARATOR)} ".join(parts) + " " + _literal(TERMINATOR))
+    root = f"root ::= statement{{1,{syntax.max_statements}}} {_literal(PROGRAM_END)}"
+    if syntax.refusal:
+        root += f" | {_literal(NO_PROGRAM + LINE_END + PROGRAM_END)}"
+    lines = [root, f"statement ::= ({' | '.join(alternatives)}) {_literal(LINE_END)}"]
     lines.extend(f"{name} ::= {body}" for name, body in rules.items())
     return "\n".join(lines) + "\n"
 
 
-def _statement(skill: Skill, rules: dict[str, str], profile: Profile) -> str:
-    if not skill.params:
-        return f'"{skill.keyword};"'
-    parts = [_argument(p, rules, profile) for p in skill.params]
-    return f'"{skill.keyword} " ' + ' ", " '.join(parts) + ' ";"'
+def _argument(arg: Argument, fallback: str, rules: dict[str, str], names: dict[str, str]) -> str:
+    if isinstance(arg, ObjectShape):
+        name = "object"  # one narrowing applies to every object argument
+        body = (f"[a-zA-Z_] [a-zA-Z0-9_]{{0,{MAX_IDENTIFIER - 1}}}" if arg.names is None
+                else " | ".join(_literal(n) for n in arg.names))
+    elif arg.literals:
+        name = f"number-{fallback}"
+        body = " | ".join(_literal(n) for n in sorted(arg.literals))
+    else:
+        name = f"{'coordinate' if arg.signed else 'number'}-{arg.digits}"
+        body = _number(arg)
+    if body not in names:
+        names[body] = name.replace("_", "-")
+        rules[names[body]] = body
+    return names[body]
 
 
-def _argument(param: Param, rules: dict[str, str], profile: Profile) -> str:
-    if param.kind == "object":
-        return "object"
-    high = param.max if param.max is not None else 99.0
-    low = param.min if param.min is not None else 0.0
-    magnitude = max(abs(high), abs(low))
-    digits = max(1, len(str(math.floor(magnitude))))
-    signed = param.is_coordinate and low < 0
-    name = f"{'coordinate' if signed else 'number'}-{digits}"
-    if name not in rules:
-        integer = '("0" | [1-9]' + (f" [0-9]{{0,{digits - 1}}}" if digits > 1 else "") + ")"
-        fraction = f'("." [0-9]{{1,{MAX_FRACTION_DIGITS}}})?'
-        rules[name] = ('"-"? ' if signed else "") + f"{integer} {fraction}"
-    return name
+def _number(shape: NumberShape) -> str:
+    rest = f" [0-9]{{0,{shape.digits - 1}}}" if shape.digits > 1 else ""
+    integer = f'("0" | [1-9]{rest})'
+    return ('"-"? ' if shape.signed else "") + f'{integer} ("." [0-9]{{1,{MAX_FRACTION_DIGITS}}})?'
 
 
-def _object_rule(objects: Sequence[str] | None) -> str:
-    if objects is None:
-        return "[a-zA-Z_] [a-zA-Z0-9_]{0,31}"
-    return " | ".join(f'"{name}"' for name in sorted(set(objects)))
+def _literal(text: str) -> str:
+    return '"' + text.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'

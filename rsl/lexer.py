@@ -10,10 +10,13 @@ failed alternative and was several times slower on long programs.
 from __future__ import annotations
 
 import bisect
+import re
 from dataclasses import dataclass
 from enum import Enum
 
 import pyparsing as pp
+
+from rsl.syntax import COMMENT, DECIMAL, IDENTIFIER, SEPARATOR, TERMINATOR
 
 
 class Kind(Enum):
@@ -31,19 +34,24 @@ class Kind(Enum):
 
 # Order matters: earlier alternatives win at the same position.
 _PATTERNS: tuple[tuple[Kind, str], ...] = (
-    (Kind.COMMENT, r"//[^\n]*|/\*[\s\S]*?\*/"),
+    (Kind.COMMENT, COMMENT),
     # An unterminated block comment runs to the end; a lone `/` swallows its
     # line, since the writer almost certainly meant a `//` comment there.
     (Kind.BAD_COMMENT, r"/\*[\s\S]*|/[^\n]*"),
+    # C's other integer spellings, hexadecimal `0x10`, binary `0b1` and octal
+    # `010`, are not RSL numbers; a C reader would take `010` for 8.
+    (Kind.BAD_NUMBER, r"[-+]?0[xXbBoO][\w.]*|[-+]?0[0-9]+(?![\w.])"),
     # A C decimal: digits with an optional fraction and exponent. The sign is
     # lexed with the number so `-1` can be reported as "not positive".
-    (Kind.NUMBER, r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?(?![\w.])"),
+    (Kind.NUMBER, rf"[-+]?{DECIMAL}(?![\w.])"),
     # Starts with a digit but runs on with letters and no dot: `3apple`.
-    (Kind.BAD_IDENT, r"\d+[A-Za-z_]\w*(?![\w.])"),
+    (Kind.BAD_IDENT, r"[0-9]+[A-Za-z_]\w*(?![\w.])"),
     (Kind.BAD_NUMBER, r"[-+]?(?:\d|\.\d)[\w.]*"),
-    (Kind.IDENT, r"[A-Za-z_]\w*"),
-    (Kind.SEMI, r";"),
-    (Kind.COMMA, r","),
+    (Kind.IDENT, rf"{IDENTIFIER}(?!\w)"),
+    # A word with a non-ASCII letter or digit (`café`, `x²`): one bad name, not a name and junk.
+    (Kind.BAD_IDENT, r"\w+"),
+    (Kind.SEMI, re.escape(TERMINATOR)),
+    (Kind.COMMA, re.escape(SEPARATOR)),
     # Anything else that is not C whitespace, including Unicode spaces and
     # control characters, which would otherwise vanish without a word.
     (Kind.ILLEGAL, r"[^ \t\r\n\f\v]"),
@@ -57,7 +65,7 @@ _TOKEN_RE = pp.Regex("|".join(f"(?P<k{i}>{pattern})" for i, (_, pattern) in enum
 # program well under the 0.5 s budget. Its inside is then split with the
 # token patterns above, so both paths yield the same tokens.
 _ARG = r"[-+]?[\w.]+"
-_STATEMENT_RUN = rf"[A-Za-z_]\w*(?:[ \t]+{_ARG}(?:[ \t]*,[ \t]*{_ARG})*)?[ \t]*;"
+_STATEMENT_RUN = rf"{IDENTIFIER}(?:[ \t]+{_ARG}(?:[ \t]*,[ \t]*{_ARG})*)?[ \t]*;"
 # No named groups here: pyparsing copies every group into its results, and
 # that bookkeeping cost more than the scan itself.
 _LEXEME = pp.Regex("|".join([_STATEMENT_RUN, *(f"(?:{pattern})" for _, pattern in _PATTERNS)]))

@@ -1,13 +1,16 @@
 """The robot profile: the one source of truth for a robot's skills.
 
 A profile is a TOML file. Everything that knows about skills (the parser,
-diagnostics, grammar export, prompt, docs, training data and the backends'
-speed limits) reads it from here, so adding a skill is a data change.
+diagnostics, grammar export, prompt, docs, training data and the backends)
+reads it from here, so adding a skill is a data change. What a skill does is
+its binding: one of the robot primitives every backend implements, or a ROS 2
+topic, service or joint trajectory (docs/skills.md).
 """
 
 from __future__ import annotations
 
 import hashlib
+import json
 import keyword as python_keyword
 import re
 import tomllib
@@ -21,6 +24,26 @@ SKILL_KEYWORD = re.compile(r"[a-z][a-z0-9_]*\Z")
 _AMOUNT = re.compile(r"\d\s*[a-z]+\b")
 
 ParamKind = Literal["number", "object"]
+
+# The robot primitives: what the simulator and the ROS 2 backend know how to do,
+# each with the parameters it takes (kind and unit) in order. A skill bound to a
+# primitive must declare exactly these; its keyword is free.
+PRIMITIVES: dict[str, tuple[tuple[ParamKind, str], ...]] = {
+    "drive": (("number", "m"),),       # straight along the heading; sign -1 drives backward
+    "turn": (("number", "rad"),),      # on the spot; sign +1 is left (counter-clockwise)
+    "pan": (("number", "rad"),),       # the head; sign +1 is left
+    "tilt": (("number", "rad"),),      # the head; sign +1 is up
+    "navigate": (("number", "m"), ("number", "m")),  # to a point; the params' axis says which is x and y
+    "approach_object": (("object", ""),),  # drive up to an object and face it
+    "perceive_objects": (),                # look with the camera; objects in view become known
+    "grasp_object": (("object", ""),),     # pick up an object within reach
+}
+SIGNED_PRIMITIVES = ("drive", "turn", "pan", "tilt")
+# The ROS 2 bindings for robot-specific skills.
+ROS_BINDINGS = ("topic", "trigger", "setbool", "joint_trajectory")
+_ROS_NAME = re.compile(r"/?[A-Za-z_][A-Za-z0-9_]*(/[A-Za-z_][A-Za-z0-9_]*)*\Z")
+_MESSAGE_TYPE = re.compile(r"[a-z][a-z0-9_]*/msg/[A-Z][A-Za-z0-9]*\Z")
+_FIELD_PATH = re.compile(r"[a-z][a-z0-9_]*(\.[a-z][a-z0-9_]*)*\Z")
 
 
 class ProfileError(ValueError):
@@ -44,6 +67,53 @@ class Param:
 
 
 @dataclass(frozen=True)
+class Primitive:
+    """A skill that is one of the robot primitives, e.g. `drive` with sign -1 for backward."""
+
+    name: str  # a key of PRIMITIVES
+    sign: float = 1.0
+
+    def describe(self) -> str:
+        if self.name not in SIGNED_PRIMITIVES:
+            return f"primitive `{self.name}`"
+        return f"primitive `{self.name}`, sign {self.sign:+g}"
+
+
+# A value sent to the robot: a parameter's name (its value at run time) or a constant.
+Source = str | float | bool
+
+
+@dataclass(frozen=True)
+class RosBinding:
+    """A robot-specific skill: a ROS 2 topic publish, std_srvs call or joint trajectory."""
+
+    kind: str  # one of ROS_BINDINGS
+    name: str  # the topic or service
+    message_type: str = ""  # topic: e.g. std_msgs/msg/Float64
+    fields: tuple[tuple[str, Source], ...] = ()  # topic: field path -> source
+    data: Source = True  # setbool: the request's data
+    joints: tuple[str, ...] = ()  # joint_trajectory
+    positions: tuple[Source, ...] = ()  # joint_trajectory: one per joint
+    duration: float = 0.0  # joint_trajectory: seconds to the point (time_from_start)
+
+    def describe(self) -> str:
+        if self.kind == "topic":
+            return f"publishes {self.message_type} on {self.name}"
+        if self.kind == "trigger":
+            return f"calls the std_srvs/srv/Trigger service {self.name}"
+        if self.kind == "setbool":
+            return f"calls the std_srvs/srv/SetBool service {self.name} (data {_source_text(self.data)})"
+        return f"sends a trajectory_msgs/msg/JointTrajectory to {', '.join(self.joints)} on {self.name}"
+
+
+def _source_text(source: Source) -> str:
+    return source.upper() if isinstance(source, str) else str(source).lower()
+
+
+Binding = Primitive | RosBinding
+
+
+@dataclass(frozen=True)
 class Skill:
     keyword: str
     description: str
@@ -53,14 +123,17 @@ class Skill:
     # The skill that moves the same way in reverse, named in diagnostics when
     # a negative value was written.
     opposite: str | None = None
+    # What the skill does on a robot; None only in profiles that never reach one
+    # (the backends refuse such a skill with the reason).
+    binding: Binding | None = None
     # How explain-back says one statement, e.g. "drive forward {distance}"; empty: worded from `description`.
     say: str = ""
     # A skill run first on this skill's object when the object is out of the arm's reach (`approach`).
     out_of_reach: str | None = None
-    # How the skill moves the base, for checks before motion: `drives` is the bearing (degrees from where
-    # the robot faces) of a straight drive by its distance; `turns` +1 turns left by its angle, -1 right.
-    drives: float | None = None
-    turns: float | None = None
+
+    @property
+    def primitive(self) -> Primitive | None:
+        return self.binding if isinstance(self.binding, Primitive) else None
 
     @property
     def signature(self) -> str:
@@ -89,6 +162,20 @@ class Convention:
 
 
 @dataclass(frozen=True)
+class Inability:
+    """Something people ask of robots that this one cannot do, so a request for it is refused
+    with the reason instead of being translated into the nearest skill it has."""
+
+    what: str  # e.g. "pick things up: it has no arm or gripper"
+    phrases: tuple[str, ...]  # lowercase words or phrases that ask for it, e.g. "pick up"
+
+    def asked_in(self, text: str) -> str | None:
+        """The phrase of `text` that asks for this, if any."""
+        lowered = text.lower()
+        return next((p for p in self.phrases if re.search(rf"\b{re.escape(p)}\b", lowered)), None)
+
+
+@dataclass(frozen=True)
 class Motion:
     max_linear_speed: float = 0.5
     max_angular_speed: float = 1.0
@@ -113,6 +200,7 @@ class Profile:
     ros: dict[str, Any]
     conventions: tuple[Convention, ...]
     digest: str = field(repr=False)
+    cannot: tuple[Inability, ...] = ()
     source: str = field(repr=False, default="")
 
     def skill(self, keyword: str) -> Skill | None:
@@ -121,6 +209,18 @@ class Profile:
     @property
     def keywords(self) -> tuple[str, ...]:
         return tuple(s.keyword for s in self.skills)
+
+    def inability(self, text: str) -> tuple[Inability, str] | None:
+        """What of this robot's inabilities `text` asks for, with the phrase that asks."""
+        for inability in self.cannot:
+            phrase = inability.asked_in(text)
+            if phrase is not None:
+                return inability, phrase
+        return None
+
+    def bound_to(self, primitive: str) -> Skill | None:
+        """The first skill bound to a robot primitive, to name it in advice."""
+        return next((s for s in self.skills if s.primitive is not None and s.primitive.name == primitive), None)
 
     def alias_target(self, word: str) -> str | None:
         """The skill a common synonym like `move` or `grab` stands for."""
@@ -157,10 +257,10 @@ def parse_profile(text: str, source: str = "<profile>") -> Profile:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ProfileError(f"{source}: not valid TOML: {exc}") from exc
-    return _build(data, text, source)
+    return _build(data, source)
 
 
-def _build(data: dict[str, Any], text: str, source: str) -> Profile:
+def _build(data: dict[str, Any], source: str) -> Profile:
     def fail(message: str) -> ProfileError:
         return ProfileError(f"{source}: {message}")
 
@@ -172,7 +272,7 @@ def _build(data: dict[str, Any], text: str, source: str) -> Profile:
     workspace = {axis: _pair(data.get("workspace", {}).get(axis, (-10.0, 10.0)), f"workspace.{axis}", fail)
                  for axis in ("x", "y")}
     head = {joint: _pair(data.get("head", {}).get(joint, default), f"head.{joint}", fail)
-            for joint, default in (("pan", (-1.57, 1.57)), ("tilt", (-0.6, 0.9)))}
+            for joint, default in (("pan", (-1.5708, 1.5708)), ("tilt", (-0.6, 0.9)))}
 
     skills: list[Skill] = []
     seen: set[str] = set()
@@ -202,6 +302,17 @@ def _build(data: dict[str, Any], text: str, source: str) -> Profile:
                    task=str(c.get("task", "")), program=str(c.get("program", "")))
         for c in data.get("conventions", [])
     )
+    cannot = []
+    for index, raw in enumerate(data.get("cannot", []), start=1):
+        what, phrases = raw.get("what"), raw.get("phrases")
+        if (not isinstance(what, str) or not what or not isinstance(phrases, list) or not phrases
+                or not all(isinstance(p, str) and p.strip() for p in phrases)):
+            raise fail(f"[[cannot]] #{index} needs `what` (a sentence) and `phrases` (a list of words)")
+        for phrase in phrases:
+            for skill in skills:
+                if phrase.lower() in (skill.keyword, *skill.aliases):
+                    raise fail(f"[[cannot]] phrase {phrase!r} is a word for the skill `{skill.keyword}`")
+        cannot.append(Inability(what=what, phrases=tuple(p.strip().lower() for p in phrases)))
     limits = data.get("limits", {})
     max_statements = int(limits.get("max_statements", 64))
     if max_statements < 1:
@@ -217,9 +328,32 @@ def _build(data: dict[str, Any], text: str, source: str) -> Profile:
         head=head,
         ros=dict(data.get("ros", {})),
         conventions=conventions,
-        digest=hashlib.sha256(text.encode("utf-8")).hexdigest(),
+        digest=_language_digest(data),
         source=source,
+        cannot=tuple(cannot),
     )
+
+
+# What a skill's statement is and means; bindings, spoken wording and the
+# like say how the robot does it or tells it, not what the adapter learned.
+_LANGUAGE_KEYS = ("keyword", "description", "example", "aliases", "opposite", "params")
+
+
+def _language_digest(data: dict[str, Any]) -> str:
+    """The digest of the language a profile defines: what an adapter's card pins.
+
+    It covers each skill's statement and meaning, the conventions, the
+    workspace and the statement limit: the things the prompt and the training
+    data are made of. Rebinding a skill, rewording how it is explained or
+    changing a joint limit keeps the adapter; renaming a skill does not.
+    """
+    language = {
+        "skills": [{key: skill.get(key) for key in _LANGUAGE_KEYS} for skill in data.get("skills", [])],
+        "conventions": data.get("conventions", []),
+        "workspace": data.get("workspace", {}),
+        "limits": data.get("limits", {}),
+    }
+    return hashlib.sha256(json.dumps(language, sort_keys=True).encode("utf-8")).hexdigest()
 
 
 def _pair(value: Any, where: str, fail: Any) -> tuple[float, float]:
@@ -254,9 +388,126 @@ def _skill(raw: dict[str, Any], index: int, workspace: dict[str, tuple[float, fl
                             min=None if low is None else float(low),
                             max=None if high is None else float(high), axis=axis))
     aliases = tuple(str(a).lower() for a in raw.get("aliases", []))
+    binding = None
+    if "binding" in raw:
+        binding = _binding(raw["binding"], word, tuple(params), lambda m: fail(f"skill `{word}`: binding {m}"))
     return Skill(keyword=word, description=str(raw.get("description", "")),
                  example=str(raw.get("example", f"{word};")), params=tuple(params), aliases=aliases,
-                 opposite=raw.get("opposite"),
-                 say=str(raw.get("say", "")), out_of_reach=raw.get("out_of_reach"),
-                 drives=None if raw.get("drives") is None else float(raw["drives"]),
-                 turns=None if raw.get("turns") is None else float(raw["turns"]))
+                 opposite=raw.get("opposite"), binding=binding,
+                 say=str(raw.get("say", "")), out_of_reach=raw.get("out_of_reach"))
+
+
+def _binding(raw: Any, word: str, params: tuple[Param, ...], fail: Any) -> Binding:
+    if not isinstance(raw, dict):
+        raise fail("must be a table, e.g. { primitive = \"drive\", sign = 1 } or "
+                   "{ ros = \"trigger\", service = \"/dock\" }")
+    if ("primitive" in raw) == ("ros" in raw):
+        raise fail("needs exactly one of `primitive` (one of "
+                   f"{', '.join(PRIMITIVES)}) or `ros` (one of {', '.join(ROS_BINDINGS)})")
+    if "primitive" in raw:
+        return _primitive(raw, params, fail)
+    return _ros_binding(raw, params, fail)
+
+
+def _primitive(raw: dict[str, Any], params: tuple[Param, ...], fail: Any) -> Primitive:
+    _only(raw, {"primitive", "sign"}, fail)
+    name = raw["primitive"]
+    if name not in PRIMITIVES:
+        raise fail(f"primitive {name!r} is not one of {', '.join(PRIMITIVES)}; a skill the robot does "
+                   f"another way takes a `ros` binding ({', '.join(ROS_BINDINGS)})")
+    wanted = PRIMITIVES[name]
+    got = tuple((p.kind, p.unit if p.kind == "number" else "") for p in params)
+    if got != wanted:
+        shape = ", ".join(f"{kind} in {unit}" if unit else kind for kind, unit in wanted) or "no parameters"
+        declared = ", ".join(f"{p.name} ({p.kind} in {p.unit})" if p.unit else f"{p.name} ({p.kind})"
+                             for p in params)
+        raise fail(f"primitive `{name}` takes {shape}; the skill declares {declared or 'none'}")
+    if name == "navigate" and sorted(str(p.axis) for p in params) != ["x", "y"]:
+        raise fail("primitive `navigate` needs one parameter with axis = \"x\" and one with axis = \"y\"")
+    sign = raw.get("sign")
+    if name in SIGNED_PRIMITIVES:
+        if sign not in (1, -1) or isinstance(sign, bool):
+            raise fail(f"primitive `{name}` needs sign = 1 or sign = -1 ({_SIGN_MEANING[name]})")
+    elif sign is not None:
+        raise fail(f"primitive `{name}` has no direction, so no sign")
+    return Primitive(name=name, sign=float(sign if sign is not None else 1))
+
+
+_SIGN_MEANING = {"drive": "-1 drives backward", "turn": "+1 turns left", "pan": "+1 pans left",
+                 "tilt": "+1 tilts up"}
+
+
+def _ros_binding(raw: dict[str, Any], params: tuple[Param, ...], fail: Any) -> RosBinding:
+    kind = raw["ros"]
+    if kind not in ROS_BINDINGS:
+        raise fail(f"ros {kind!r} is not one of {', '.join(ROS_BINDINGS)}")
+    where = "service" if kind in ("trigger", "setbool") else "topic"
+    allowed = {"ros", where, *{"topic": ("type", "fields"), "trigger": (), "setbool": ("data",),
+                               "joint_trajectory": ("joints", "positions", "duration")}[kind]}
+    _only(raw, allowed, fail)
+    name = raw.get(where)
+    if not isinstance(name, str) or not _ROS_NAME.match(name):
+        raise fail(f"`{where}` must be a ROS 2 name such as \"/dock\", got {name!r}")
+    names = {p.name for p in params}
+
+    def source(value: Any, what: str) -> Source:
+        if isinstance(value, str):
+            if value not in names:
+                raise fail(f"{what} takes the parameter {value!r}, which the skill does not declare "
+                           f"(its parameters: {', '.join(sorted(names)) or 'none'})")
+            return value
+        if isinstance(value, bool | int | float):
+            return value if isinstance(value, bool) else float(value)
+        raise fail(f"{what} must be a parameter's name or a constant, got {value!r}")
+
+    def all_used(sources: list[Source], into: str) -> None:
+        unused = names - {s for s in sources if isinstance(s, str)}
+        if unused:
+            raise fail(f"does not send the parameter(s) {', '.join(sorted(unused))}; {into}")
+
+    if kind == "topic":
+        message_type = raw.get("type")
+        if not isinstance(message_type, str) or not _MESSAGE_TYPE.match(message_type):
+            raise fail(f"`type` must be a message type such as \"std_msgs/msg/Float64\", got {message_type!r}")
+        raw_fields = raw.get("fields", {})
+        if not isinstance(raw_fields, dict):
+            raise fail("`fields` must map message fields to parameters, e.g. { data = \"level\" }")
+        fields = []
+        for path, value in raw_fields.items():
+            if not _FIELD_PATH.match(path):
+                raise fail(f"field {path!r} must be a field path such as \"data\" or \"linear.x\"")
+            fields.append((path, source(value, f"field `{path}`")))
+        all_used([v for _, v in fields], "map each to a message field")
+        return RosBinding(kind=kind, name=name, message_type=message_type, fields=tuple(fields))
+    if kind == "trigger":
+        all_used([], "a Trigger request carries none, so declare params = []")
+        return RosBinding(kind=kind, name=name)
+    if kind == "setbool":
+        data = raw.get("data")
+        if not isinstance(data, bool):
+            raise fail("`data` must be true or false, the SetBool request's value")
+        all_used([], "a SetBool request carries only its constant `data`, so declare params = []")
+        return RosBinding(kind=kind, name=name, data=data)
+    joints = raw.get("joints")
+    positions = raw.get("positions")
+    if (not isinstance(joints, list) or not joints
+            or not all(isinstance(j, str) and IDENTIFIER.match(j) for j in joints)):
+        raise fail(f"`joints` must be a list of joint names, got {joints!r}")
+    if not isinstance(positions, list) or len(positions) != len(joints):
+        raise fail(f"`positions` must give one position per joint ({len(joints)}), got {positions!r}")
+    sources = [source(p, f"the position of `{j}`") for j, p in zip(joints, positions, strict=True)]
+    all_used(sources, "give each as a joint's position")
+    objects = [p.name for p in params if p.kind == "object"]
+    if objects:
+        raise fail(f"a joint position must be a number, and {', '.join(objects)} is an object")
+    duration = raw.get("duration", 1.0)
+    if isinstance(duration, bool) or not isinstance(duration, int | float) or duration < 0:
+        raise fail(f"`duration` must be seconds >= 0 (the trajectory point's time_from_start), got {duration!r}")
+    return RosBinding(kind=kind, name=name, joints=tuple(joints), positions=tuple(sources),
+                      duration=float(duration))
+
+
+def _only(raw: dict[str, Any], allowed: set[str], fail: Any) -> None:
+    unknown = sorted(set(raw) - allowed)
+    if unknown:
+        raise fail(f"has unknown key(s) {', '.join(unknown)}; this form takes {', '.join(sorted(allowed))}")

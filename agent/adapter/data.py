@@ -245,22 +245,11 @@ def program_conventions(conventions: Sequence[Convention], profile: Profile) -> 
 
 
 def _parse_program(text: str, profile: Profile) -> list[Command] | None:
-    commands = []
-    for statement in (s.strip() for s in text.split(";")):
-        if not statement:
-            continue
-        keyword, _, rest = statement.partition(" ")
-        skill = profile.skill(keyword)
-        if skill is None:
-            return None
-        values = [v.strip() for v in rest.split(",")] if rest.strip() else []
-        if len(values) != len(skill.params):
-            return None
-        args: list[Quantity | ObjectRef] = []
-        for param, value in zip(skill.params, values, strict=True):
-            args.append(ObjectRef(value) if param.kind == "object" else Quantity(float(value), param.unit))
-        commands.append(Command(keyword, tuple(args), 0, 0))
-    return commands
+    """The commands of a convention's program, read by the compiler; None when it does not compile."""
+    from rsl.compiler import compile_program
+
+    plan = compile_program(text, profile).plan
+    return None if plan is None else list(plan)
 
 
 @dataclass(frozen=True)

@@ -13,13 +13,18 @@ EXIT_NOT_DONE = 1
 EXIT_NO_DAEMON = 2
 EXIT_REFUSED = 3
 
-_SOCKET_HELP = "daemon socket (default: $NRTRANS_SOCKET, else the daemon's default under the runtime dir)"
+_SOCKET_HELP = (
+    "daemon socket (default: $NRTRANS_SOCKET, else api.socket in the config file, "
+    "else nrtrans.sock in the runtime dir, as `nrtrans serve` picks it)"
+)
+_CONFIG_HELP = "the daemon's config file, read for api.socket (default: $NRTRANS_CONFIG)"
 
 
 def register(subparsers: Any) -> None:
     def add(name: str, help: str, description: str, func: Any) -> argparse.ArgumentParser:
         parser = subparsers.add_parser(name, help=help, description=description)
         parser.add_argument("--socket", metavar="PATH", help=_SOCKET_HELP)
+        parser.add_argument("--config", metavar="FILE", help=_CONFIG_HELP)
         parser.add_argument("--json", action="store_true", help="print the raw JSON frames")
         parser.set_defaults(func=func)
         return parser
@@ -109,7 +114,7 @@ def register(subparsers: Any) -> None:
 def _connect(args: argparse.Namespace) -> Any:
     from agent.client import Client
 
-    return Client.connect(args.socket, timeout=None)
+    return Client.connect(args.socket, timeout=None, config_file=args.config)
 
 
 def _call(args: argparse.Namespace, action: Any) -> int:
@@ -228,8 +233,12 @@ def _estop(args: argparse.Namespace) -> int:
 
 def _reset(args: argparse.Namespace) -> int:
     def action(client: Any) -> int:
+        latched = client.status().get("estop")
         client.reset()
-        print("emergency stop released: tasks are accepted again")
+        if latched:
+            print(f"emergency stop released ({latched}): tasks are accepted again")
+        else:
+            print("no emergency stop was latched: nothing to release; tasks are accepted")
         return 0
 
     return _call(args, action)
@@ -241,13 +250,26 @@ def _health(args: argparse.Namespace) -> int:
         if args.json:
             print(json.dumps(reply, indent=2))
         else:
-            print("healthy" if reply["healthy"] else "NOT healthy")
+            print(_health_headline(reply))
             for name, part in reply["components"].items():
-                detail = part.get("detail") or part.get("model") or part.get("backend") or part.get("path") or ""
-                print(f"  {name:<11} {'ok ' if part.get('ok') else 'BAD'}  {detail}")
+                mark = "ok " if part.get("ok") else "off" if part.get("enabled") is False else "BAD"
+                print(f"  {name:<11} {mark}  {part.get('detail', '')}")
+                if part.get("help"):
+                    print(f"  {'':<11}      = help: {part['help']}")
         return 0 if reply["healthy"] else 1
 
     return _call(args, action)
+
+
+def _health_headline(reply: dict[str, Any]) -> str:
+    bad = [
+        name for name, part in reply["components"].items() if not part.get("ok") and part.get("enabled") is not False
+    ]
+    if not reply["healthy"]:
+        return f"NOT healthy: {', '.join(bad)} {'is' if len(bad) == 1 else 'are'} not working"
+    if bad:
+        return f"working, but {', '.join(bad)} {'needs' if len(bad) == 1 else 'need'} attention"
+    return "healthy"
 
 
 def _history(args: argparse.Namespace) -> int:

@@ -13,8 +13,9 @@ def register(subparsers: Any) -> None:
         "demo", help="start the daemon on the simulator with the bundled model and carry out a task",
         description="Start `nrtrans serve` on the simulator with the embedded model, wait until it is "
                     "ready, submit each TASK over its socket as `nrtrans send` would, print the events "
-                    "up to the end of each task, then stop the daemon. Exit status 0 when every task "
-                    "was done.")
+                    "up to the end of each task and where the pictures of its run are (trajectory plot, "
+                    "animation, camera snapshots, under ~/.local/state/nrtrans/demo/pictures), then stop "
+                    "the daemon. Exit status 0 when every task was done.")
     demo.add_argument("tasks", nargs="*", metavar="TASK", default=list(DEFAULT_TASKS),
                       help=f"tasks in plain English (default: {DEFAULT_TASKS[0]!r})")
     demo.add_argument("--realtime-factor", type=float, default=1.0, metavar="F",

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import sys
 from pathlib import Path
@@ -105,8 +106,9 @@ def _check(args: argparse.Namespace) -> int:
         for diagnostic in result.diagnostics:
             print(diagnostic.render())
         count = len(result.diagnostics)
-        summary = (f"{args.file}: ok, {len(result.plan or ())} statements" if result.ok
-                   else f"{args.file}: {count} error{'s' if count != 1 else ''}")
+        name = "standard input" if args.file == "-" else args.file
+        summary = (f"{name}: ok, {len(result.plan or ())} statements" if result.ok
+                   else f"{name}: {count} error{'s' if count != 1 else ''}")
         print(summary, file=sys.stderr)
     return EXIT_OK if result.ok else EXIT_ERRORS
 
@@ -123,7 +125,8 @@ def _compile(args: argparse.Namespace) -> int:
     if not result.ok or result.plan is None:
         for diagnostic in result.diagnostics:
             print(diagnostic.render(), file=sys.stderr)
-        print(f"{args.file}: not compiled, {len(result.diagnostics)} errors", file=sys.stderr)
+        count = len(result.diagnostics)
+        print(f"{args.file}: not compiled, {count} error{'s' if count != 1 else ''}", file=sys.stderr)
         return EXIT_ERRORS
     emit = args.emit or ("plan" if args.output and args.output.endswith(".json") else "python")
     if emit == "python":
@@ -173,7 +176,10 @@ def _profile_show(args: argparse.Namespace) -> int:
             "skills": [{"keyword": s.keyword, "signature": s.signature, "description": s.description,
                         "example": s.example,
                         "params": [{"name": p.name, "kind": p.kind, "unit": p.unit, "min": p.min,
-                                    "max": p.max, "axis": p.axis} for p in s.params]}
+                                    "max": p.max, "axis": p.axis} for p in s.params],
+                        "binding": None if s.binding is None else {
+                            "form": "primitive" if s.primitive is not None else "ros", **dataclasses.asdict(s.binding),
+                            "does": s.binding.describe()}}
                        for s in profile.skills],
             "conventions": [c.__dict__ for c in profile.conventions],
         }, indent=2))

@@ -163,7 +163,8 @@ def _execute(plan: Any, backend: str, profile: Any, args: argparse.Namespace, ca
 
         execution = execute(plan, robot, profile, cancel=cancel, on_event=on_event)
         if recorder is not None:
-            written = recorder.finish(execution, title=Path(args.program).name)
+            title = "program from standard input" if args.program == "-" else Path(args.program).name
+            written = recorder.finish(execution, title=title)
             print(f"recorded {len(written)} picture(s) in {record}", file=sys.stderr)
         return execution
     finally:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import sys
 from typing import Any
 
@@ -23,7 +24,9 @@ def register(subparsers: Any) -> None:
     parser.add_argument(
         "--config", metavar="FILE", help="config file (TOML); default: $NRTRANS_CONFIG, else built-in defaults"
     )
-    parser.add_argument("--socket", metavar="PATH", help="Unix socket path (overrides api.socket)")
+    parser.add_argument(
+        "--socket", metavar="PATH", help="Unix socket path (default: $NRTRANS_SOCKET, else api.socket)"
+    )
     parser.add_argument("--state-dir", metavar="DIR", help="audit log directory (overrides state_dir)")
     parser.add_argument("--backend", choices=("sim", "ros2"), help="robot backend (overrides robot.backend)")
     parser.add_argument(
@@ -54,7 +57,9 @@ def run(args: argparse.Namespace) -> int:
     from agent.daemon.runner import reloader, serve
 
     config_file = config_module.config_path_from_env(args.config)
-    overrides = {"socket": args.socket, "state_dir": args.state_dir, "backend": args.backend}
+    # The socket is found in the same order as the client commands look for it (agent.client.find_socket).
+    socket = args.socket or os.environ.get("NRTRANS_SOCKET")
+    overrides = {"socket": socket, "state_dir": args.state_dir, "backend": args.backend}
     try:
         config = config_module.load_config(config_file).with_overrides(**overrides)
     except config_module.ConfigError as exc:

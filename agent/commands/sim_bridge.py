@@ -18,7 +18,8 @@ def register(subparsers: Any) -> None:
         description="Run the pybullet robot as if it were a ROS 2 robot: it drives on cmd_vel, "
                     "publishes odom, joint_states and objects, follows goal_pose, runs head and "
                     "gripper joint trajectories, and offers the perceive and grasp services, with "
-                    "every name taken from the profile's [ros] table (see docs/ros2.md). Then "
+                    "every name taken from the profile's [ros] table (see docs/ros2.md); only the "
+                    "interfaces the profile's skills are bound to are served. Then "
                     "`nrtrans run-program --backend ros2` drives it like a real robot. Runs until "
                     "SIGINT or SIGTERM, then stops the simulated base and exits 0.",
         epilog="Set ROS_DOMAIN_ID and ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST the same way on both "
@@ -68,9 +69,8 @@ def _run(args: argparse.Namespace) -> int:
     bridge = SimBridge(profile, lambda: SimWorld(profile, scene), realtime_factor=args.realtime_factor,
                        config=config)
     try:
-        print(f"sim-bridge: serving {config.cmd_vel}, {config.odom}, {config.joint_states}, "
-              f"{config.goal_pose}, {config.objects_topic}, {config.perceive_service}, "
-              f"{config.grasp_service} on ROS_DOMAIN_ID={os.environ.get('ROS_DOMAIN_ID', '0')} "
+        print(f"sim-bridge: serving {', '.join(bridge.interfaces)} for profile {profile.name} "
+              f"on ROS_DOMAIN_ID={os.environ.get('ROS_DOMAIN_ID', '0')} "
               f"at {args.realtime_factor:g}x real time; Ctrl-C to stop", file=sys.stderr, flush=True)
         while not stop.wait(0.5):
             pass

@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import argparse
 import json
+import logging
 import sys
+import time
 from typing import Any
 
 EXIT_VERIFIED, EXIT_UNVERIFIED, EXIT_USAGE = 0, 1, 2
@@ -67,7 +69,8 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--objects", metavar="A,B",
                         help="objects the robot knows; other object names are errors to repair")
     parser.add_argument("-v", "--verbose", action="store_true",
-                        help="show every attempt and its diagnostics on standard error")
+                        help="show on standard error what happens: the clauses, each pass's program and "
+                             "diagnostics, and the timings")
     add_model_options(parser)
     parser.set_defaults(func=_translate)
 
@@ -87,15 +90,19 @@ def _translate(args: argparse.Namespace) -> int:
         print("nrtrans translate: error: the task is empty.\n  Give the task in quotes, e.g. "
               "nrtrans translate \"turn left 90 degrees\"", file=sys.stderr)
         return EXIT_USAGE
+    if args.verbose:
+        _show_progress()
+    loading = time.perf_counter()
     try:
         translator = load_translator(args)
     except (ModelNotFoundError, ProfileError, EndpointError, ValueError) as exc:
         print(f"nrtrans translate: error: {exc}", file=sys.stderr)
         return EXIT_USAGE
+    logging.getLogger("nrtrans.translate").debug("model %s loaded in %.1f s", translator.model_name,
+                                                 time.perf_counter() - loading)
 
     def show(attempt: Any) -> None:
         if args.verbose:
-            print(f"-- attempt\n{attempt.program}", file=sys.stderr, end="")
             for diagnostic in attempt.diagnostics:
                 print(diagnostic.render(), file=sys.stderr, end="")
 
@@ -134,3 +141,12 @@ def _explained(result: Any) -> str:
         if result.confirm:
             text += "; nrtrans serve would ask before running it: " + "; ".join(result.doubts)
     return text
+
+
+def _show_progress() -> None:
+    """The translation loop's progress lines on standard error, each prefixed `translate:`."""
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("translate: %(message)s"))
+    progress = logging.getLogger("nrtrans.translate")
+    progress.addHandler(handler)
+    progress.setLevel(logging.DEBUG)

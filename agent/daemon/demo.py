@@ -3,6 +3,8 @@
 Starts a real `nrtrans serve` (simulator, embedded model) in a child process
 with its own socket, waits for READY=1 on a notify socket as systemd would,
 follows each task's events to the end, then stops the daemon with SIGTERM.
+The daemon records each task's run (`[robot] record`); the demo prints where
+the pictures are.
 """
 
 from __future__ import annotations
@@ -32,25 +34,27 @@ def run_demo(
 ) -> int:
     """Exit status 0 when every task was done."""
     state = state_dir or Config().state_path() / "demo"
+    pictures = state / "pictures"
     with tempfile.TemporaryDirectory(prefix="nrtrans-demo-") as scratch:
         folder = Path(scratch)
         config = folder / "config.toml"
         config.write_text(
             f'state_dir = "{state}"\nlog_level = "warning"\n[api]\nsocket = "{folder / "api.sock"}"\n'
-            f"[robot]\nrealtime_factor = {realtime_factor}\n[speech]\nenabled = false\n",
+            f'[robot]\nrealtime_factor = {realtime_factor}\nrecord = "{pictures}"\n[speech]\nenabled = false\n',
             encoding="utf-8",
         )
         notify = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
         notify.bind(str(folder / "notify"))
         notify.settimeout(0.5)
         env = {**os.environ, "NOTIFY_SOCKET": str(folder / "notify")}
+        env.pop("NRTRANS_SOCKET", None)  # the daemon listens where the demo's config says
         print("starting the daemon: nrtrans serve (simulator, embedded model)", flush=True)
         daemon = subprocess.Popen([sys.executable, "-m", "agent.cli", "serve", "--config", str(config)], env=env)
         try:
             if not _wait_ready(notify, daemon, start_timeout):
                 print("nrtrans demo: error: the daemon did not start; its errors are above", file=sys.stderr)
                 return 1
-            results = [_run_task(folder / "api.sock", task) for task in tasks]
+            results = [_run_task(folder / "api.sock", task, pictures) for task in tasks]
         except ClientError as exc:
             print(f"nrtrans demo: error: {exc}", file=sys.stderr)
             return 1
@@ -82,7 +86,7 @@ def _wait_ready(notify: socket.socket, daemon: subprocess.Popen[bytes], timeout:
     return False
 
 
-def _run_task(path: Path, task: str) -> bool:
+def _run_task(path: Path, task: str, pictures: Path) -> bool:
     print(f'\n$ nrtrans send "{task}"', flush=True)
     with Client.connect(path, timeout=None) as client:
         task_id = client.submit(text=task, follow=True)
@@ -90,4 +94,18 @@ def _run_task(path: Path, task: str) -> bool:
         for event in client.follow(task_id):
             print(describe_event(event), flush=True)
             last = event
+    _show_pictures(pictures / task_id)
     return last is not None and last["event"] == "done"
+
+
+def _show_pictures(folder: Path) -> None:
+    """Where the daemon saved the pictures of a task's run (none when nothing ran)."""
+    plot, animation = folder / "trajectory.png", folder / "run.gif"
+    if not plot.exists():
+        return
+    print(f"trajectory plot: {plot}", flush=True)
+    if animation.exists():
+        print(f"animation:       {animation}", flush=True)
+    snapshots = sorted(folder.glob("step_*.png"))
+    if snapshots:
+        print(f"camera snapshots: {len(snapshots)} in {folder}", flush=True)

@@ -63,6 +63,17 @@ def decode_request(line: bytes, *, max_task_chars: int) -> Request | ProtocolErr
         request_id = None
     op = data.get("op")
     op_name = op if isinstance(op, str) and op in REQUESTS else None
+    where = _lone_surrogate(data)
+    if where is not None:
+        # Such a string cannot be written back as UTF-8: not in a reply, an event or the audit log.
+        return ProtocolError(
+            "bad_request",
+            f"{op_name or 'the request'}: {_shorten(where, 100)}: "
+            "the string holds a lone UTF-16 surrogate (\\ud800-\\udfff)",
+            "send valid Unicode: a character outside the BMP as a surrogate pair or as plain UTF-8",
+            op=op_name,
+            id=request_id if not isinstance(request_id, str) or _is_text(request_id) else None,
+        )
     if data.get("v") != VERSION or isinstance(data.get("v"), bool):
         return ProtocolError(
             "bad_version",
@@ -98,6 +109,32 @@ def decode_request(line: bytes, *, max_task_chars: int) -> Request | ProtocolErr
                 id=request_id,
             )
     return Request(op_name, data)
+
+
+def _lone_surrogate(data: dict[str, Any]) -> str | None:
+    """The path of the first key or string value that is not valid Unicode text, or None."""
+    stack: list[tuple[str, Any]] = [("", data)]
+    while stack:
+        path, value = stack.pop()
+        if isinstance(value, str):
+            if not _is_text(value):
+                return path or "the request"
+        elif isinstance(value, dict):
+            for key, item in value.items():
+                if not _is_text(key):
+                    return f"{path}/key {key!a}" if path else f"key {key!a}"
+                stack.append((f"{path}/{key}" if path else key, item))
+        elif isinstance(value, list):
+            stack.extend((f"{path}/{index}", item) for index, item in enumerate(value))
+    return None
+
+
+def _is_text(value: str) -> bool:
+    try:
+        value.encode("utf-8")
+    except UnicodeEncodeError:
+        return False
+    return True
 
 
 def _shorten(text: str, limit: int = 200) -> str:

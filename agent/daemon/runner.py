@@ -18,6 +18,7 @@ from pathlib import Path
 
 from agent.daemon.config import Config, ConfigError, load_config
 from agent.daemon.notify import Notifier, listen_fds, watchdog_interval
+from agent.daemon.preflight import startup_problems
 from agent.daemon.server import SocketServer
 from agent.daemon.service import Service, StartupError
 
@@ -29,9 +30,19 @@ def serve(config: Config, *, config_file: Path | None = None, reload: Callable[[
     started = time.monotonic()
 
     def status(text: str) -> None:
-        log.info("%s", text)
+        # The idle line is logged once, when the daemon is ready, not again after every task.
+        if text != service.idle_status():
+            log.info("%s", text)
         notifier.status(text)
 
+    fds = listen_fds()
+    problems = startup_problems(config, socket_activated=bool(fds))
+    if problems:
+        for problem in problems:
+            print(f"nrtrans serve: error: {problem}", file=sys.stderr)
+        notifier.send(f"STATUS=failed to start: {problems[0]}")
+        notifier.close()
+        return 1
     service = Service(config, on_status=status)
     try:
         service.load()
@@ -41,7 +52,7 @@ def serve(config: Config, *, config_file: Path | None = None, reload: Callable[[
         service.shutdown("startup failed")
         return 1
     try:
-        code = asyncio.run(_serve(service, notifier, started, config_file, reload))
+        code = asyncio.run(_serve(service, notifier, started, fds, config_file, reload))
     except StartupError as exc:
         print(f"nrtrans serve: error: {exc}", file=sys.stderr)
         service.shutdown("startup failed")
@@ -52,19 +63,25 @@ def serve(config: Config, *, config_file: Path | None = None, reload: Callable[[
         # Still inside the model after the grace period, with every record already final:
         # leave now rather than finalize the interpreter under a running native thread.
         log.warning("the translator did not finish within the grace period; exiting without waiting for it")
+        log.info("stopped (exit status %d)", code)
         logging.shutdown()
         sys.stdout.flush()
         sys.stderr.flush()
         os._exit(code)
+    log.info("stopped (exit status %d)", code)
     return code
 
 
 async def _serve(
-    service: Service, notifier: Notifier, started: float, config_file: Path | None, reload: Callable[[], Config] | None
+    service: Service,
+    notifier: Notifier,
+    started: float,
+    fds: list[int],
+    config_file: Path | None,
+    reload: Callable[[], Config] | None,
 ) -> int:
     loop = asyncio.get_running_loop()
     server = SocketServer(service.config, service)
-    fds = listen_fds()
     await server.start(fds[0] if fds else None)
     stop = asyncio.Event()
     stop_reason: list[str] = []
@@ -96,7 +113,7 @@ async def _serve(
 
     ready_s = time.monotonic() - started
     notifier.ready(service.idle_status())
-    log.info("ready in %.2f s: %s", ready_s, service.idle_status())
+    log.info("%s (started in %.2f s)", service.idle_status(), ready_s)
     pinger = asyncio.create_task(_watchdog(service, notifier))
     try:
         await stop.wait()

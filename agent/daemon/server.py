@@ -28,6 +28,9 @@ from agent.daemon.tasks import Peer
 log = logging.getLogger(__name__)
 
 _READ_CHUNK = 65536
+# Past `api.max_clients`, this many more connections may each send one `estop`, within this time.
+_RESERVED_CONNECTIONS = 16
+_RESERVED_WAIT_S = 5.0
 
 
 def peer_credentials(sock: socket.socket) -> Peer:
@@ -169,6 +172,7 @@ class SocketServer:
         self.clients: set[Client] = set()
         self._server: asyncio.AbstractServer | None = None
         self._path: Path | None = None
+        self._reserved = 0
 
     async def start(self, inherited_fd: int | None = None) -> None:
         if inherited_fd is not None:
@@ -195,6 +199,9 @@ class SocketServer:
         if refusal is not None:
             await _refuse(reader, writer, refusal)
             return
+        if len(self.clients) >= self.config.api.max_clients:
+            await self._estop_only(reader, writer, peer)
+            return
         client = Client(self, reader, writer, peer)
         writer_task = asyncio.create_task(client.write_loop())
         self.clients.add(client)
@@ -219,13 +226,44 @@ class SocketServer:
                 f"uid {peer.uid} / gid {peer.gid} may not use this daemon",
                 "ask the operator to add your uid to api.allowed_uids or your group to api.allowed_gids",
             )
-        if len(self.clients) >= api.max_clients:
-            return error_frame(
-                "busy",
-                f"{len(self.clients)} clients are connected (the limit is {api.max_clients})",
-                "close idle connections and try again",
-            )
         return None
+
+    async def _estop_only(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter, peer: Peer) -> None:
+        """Serve one `estop` on a connection past the client limit; anything else gets `busy`.
+
+        An emergency stop must get through however many clients hold a connection.
+        """
+        api = self.config.api
+        busy = error_frame(
+            "busy",
+            f"{len(self.clients)} clients are connected (the limit is {api.max_clients}); "
+            "only an `estop` is served on this connection",
+            "close idle connections and try again",
+        )
+        if self._reserved >= _RESERVED_CONNECTIONS:
+            await _refuse(reader, writer, busy)
+            return
+        self._reserved += 1
+        try:
+            try:
+                async with asyncio.timeout(_RESERVED_WAIT_S):
+                    line = await reader.readline()
+            except (TimeoutError, ValueError, ConnectionError, OSError):
+                line = b""
+            decoded = decode_request(line, max_task_chars=api.max_task_chars) if line.strip() else None
+            if isinstance(decoded, Request) and decoded.op == "estop":
+                self._estop(peer, decoded.body)
+                reply = reply_frame(decoded, latched=True)
+            elif isinstance(decoded, ProtocolError) and decoded.op == "estop":
+                reply = decoded.frame()
+            else:
+                reply = {**busy, **({"op": decoded.op, "id": decoded.id} if decoded is not None else {})}
+            await _refuse(reader, writer, reply)
+        finally:
+            self._reserved -= 1
+
+    def _estop(self, peer: Peer, body: dict[str, Any]) -> None:
+        self.service.estop(body.get("reason") or f"requested by uid {peer.uid} (pid {peer.pid})")
 
     async def dispatch(self, client: Client, request: Request) -> dict[str, Any]:
         service = self.service
@@ -254,7 +292,7 @@ class SocketServer:
             task = service.confirm(body["task"], bool(body["accept"]), f"uid {client.peer.uid}")
             return reply_frame(request, task=task.id, accepted=bool(body["accept"]))
         if request.op == "estop":
-            service.estop(body.get("reason") or f"requested by uid {client.peer.uid} (pid {client.peer.pid})")
+            self._estop(client.peer, body)
             return reply_frame(request, latched=True)
         if request.op == "reset":
             service.reset()
@@ -299,7 +337,13 @@ async def _refuse(reader: asyncio.StreamReader, writer: asyncio.StreamWriter, re
 
 
 def _bind(path: Path, mode: int) -> socket.socket:
-    path.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise StartupError(
+            f"cannot create the socket directory {path.parent}: {exc.strerror}\n"
+            "  = help: choose a writable place with --socket"
+        ) from exc
     if path.exists() or path.is_symlink():
         if not stat.S_ISSOCK(path.lstat().st_mode):
             raise StartupError(

@@ -15,12 +15,14 @@ import threading
 import time
 from collections import OrderedDict
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 from agent.daemon.audit import AuditError, AuditLog
 from agent.daemon.config import Config
 from agent.daemon.confirm import Question
 from agent.daemon.events import EventBus
+from agent.daemon.health import describe
 from agent.daemon.protocol import ProtocolError
 from agent.daemon.tasks import Busy, Peer, Task, TaskQueue, TaskState
 from agent.daemon.world_checks import check_world
@@ -234,6 +236,7 @@ class Service:
             was_latched = self._estop_reason is not None
             self._estop_reason = None
         if was_latched:
+            log.info("emergency stop released")
             self.events.publish("reset", None)
             self.on_status(self.idle_status())
         return was_latched
@@ -278,8 +281,13 @@ class Service:
             "robot": robot,
             "audit": {"ok": self.audit._file is not None, "path": str(self.audit.path)},
             "speech": speech,
-            "estop": {"ok": self._estop_reason is None, "latched": self._estop_reason is not None},
+            "estop": {
+                "ok": self._estop_reason is None,
+                "latched": self._estop_reason is not None,
+                "reason": self._estop_reason,
+            },
         }
+        describe(components, backend=self.config.robot.backend, speech_problem=self.speech_problem)
         # Speech is optional: the daemon is healthy without a microphone.
         healthy = all(components[k]["ok"] for k in ("worker", "translator", "robot", "audit"))
         return healthy, components
@@ -386,7 +394,16 @@ class Service:
             task.attempts.append(entry)
             self.events.publish("attempt", task.id, **entry)
 
-        result = self.translator.translate(task.text, known_objects=known, on_attempt=on_attempt)
+        from agent.translate.engine import GenerationCancelled
+
+        try:
+            result = self.translator.translate(task.text, known_objects=known, on_attempt=on_attempt,
+                                               cancel=task.cancel)
+        except GenerationCancelled:
+            # Cut off mid-generation: a cancel or an estop need not wait for the translation to end.
+            task.mark("translate_ms", start)
+            self._finish(task, TaskState.CANCELLED, task.cancel.reason)
+            return None
         task.mark("translate_ms", start)
         task.model = getattr(result, "model", None)
         for name, value in (getattr(result, "timings_ms", None) or {}).items():
@@ -456,7 +473,14 @@ class Service:
             )
 
         assert self._execute_plan is not None, "load() sets the executor"
-        result = self._execute_plan(plan, self.robot, self.profile, cancel=task.cancel, on_event=on_step)
+        recorder = self._recorder(task)
+        on_event = on_step if recorder is None else _both(recorder.on_event, on_step)
+        result = None
+        try:
+            result = self._execute_plan(plan, self.robot, self.profile, cancel=task.cancel, on_event=on_event)
+        finally:
+            if recorder is not None:
+                _save_pictures(task, recorder, result)
         task.mark("total_ms", start)
         status = getattr(result.status, "value", result.status)
         final_state = result.final_state.to_dict() if result.final_state is not None else None
@@ -515,6 +539,18 @@ class Service:
             _quietly(lambda: self.speech.say(text, wait_s=wait_s))
 
     # -- helpers ---------------------------------------------------------------------------
+
+    def _recorder(self, task: Task) -> Any:
+        """Pictures of this task's run when [robot] record names a directory; they never fail a task."""
+        if not self.config.robot.record:
+            return None
+        try:
+            from agent.record import Recorder
+
+            return Recorder(Path(self.config.robot.record).expanduser() / task.id, self.robot, gif=True)
+        except Exception as exc:
+            log.warning("task %s: no pictures: %s", task.id, exc)
+            return None
 
     def _halted(self, task: Task) -> bool:
         """Finish `task` as cancelled if it was cancelled or an emergency stop is latched."""
@@ -636,6 +672,25 @@ def _last_reason(result: Any) -> str:
         if getattr(outcome, "reason", ""):
             return str(outcome.reason)
     return ""
+
+
+def _save_pictures(task: Task, recorder: Any, result: Any) -> None:
+    try:
+        pictures = recorder.finish(result, title=task.text or "RSL program")
+        log.info("task %s: %d picture(s) in %s", task.id, len(pictures), pictures[0].parent)
+    except Exception as exc:
+        log.warning("task %s: the pictures were not saved: %s", task.id, exc)
+
+
+def _both(pictures: Callable[[Any], None], on_step: Callable[[Any], None]) -> Callable[[Any], None]:
+    def call(event: Any) -> None:
+        try:
+            pictures(event)
+        except Exception as exc:  # a picture is never worth a step
+            log.warning("a picture of step %s was not saved: %s", getattr(event, "index", "?"), exc)
+        on_step(event)
+
+    return call
 
 
 def _quietly(action: Callable[[], Any]) -> None:

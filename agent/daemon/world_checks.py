@@ -7,8 +7,8 @@
   names for it (`out_of_reach = "approach"` on `grasp`) run first.
 - A straight drive through a known object is refused with where it would hit.
 
-The base is followed from its current pose only through statements whose
-motion the profile declares (`drives`, `turns`) or that do not move the base;
+The base is followed from its current pose only through statements bound to
+the `drive` and `turn` primitives (their sign says which way) or that do not move the base;
 after any other base motion (a `goto`, an `approach`) positions are no longer
 known and the checks leave the rest to the robot, which checks again as it goes.
 """
@@ -100,8 +100,12 @@ def check_world(plan: Plan, profile: Profile, robot: Any) -> WorldCheck:
                 commands.append(first)
                 added.append(first.to_rsl())
                 tracking = False
-        if tracking and skill.drives is not None and command.args and isinstance(command.args[0], Quantity):
-            bearing = heading + math.radians(skill.drives)
+        primitive = skill.primitive
+        moves = primitive.name if primitive is not None and command.args and isinstance(command.args[0], Quantity) \
+            else ""
+        if tracking and moves == "drive":
+            assert primitive is not None and isinstance(command.args[0], Quantity)
+            bearing = heading + (0.0 if primitive.sign > 0 else math.pi)
             distance = command.args[0].value
             hit = _first_hit(x, y, bearing, distance, profile.motion.width / 2,
                              (t for t in things if t.name != holding))
@@ -111,8 +115,9 @@ def check_world(plan: Plan, profile: Profile, robot: Any) -> WorldCheck:
                                         f"{thing.name} after about {at:.1f} m; nothing moved. Drive less than "
                                         f"{max(0.0, at):.1f} m, or `approach {thing.name};` to stop in front of it.")
             x, y = x + distance * math.cos(bearing), y + distance * math.sin(bearing)
-        elif tracking and skill.turns is not None and command.args and isinstance(command.args[0], Quantity):
-            heading += skill.turns * command.args[0].value
+        elif tracking and moves == "turn":
+            assert primitive is not None and isinstance(command.args[0], Quantity)
+            heading += primitive.sign * command.args[0].value
         elif parts.get(command.skill) == WHOLE:
             tracking = False
         commands.append(command)

@@ -1,9 +1,12 @@
 """`Ros2Robot`: the robot interface over standard ROS 2 topics and services.
 
-Every name comes from the profile's `[ros]` table (see `config.py` and
-docs/ros2.md). The base is driven in closed loop on odometry; the head and
-gripper through joint trajectories checked against joint states; `goto` and
-`approach` through a goal pose whose completion is judged from odometry.
+Skills run by their binding in the profile, never by keyword. Every name of a
+primitive's interface comes from the profile's `[ros]` table (see `config.py`
+and docs/ros2.md). Driving and turning are closed loop on odometry; panning,
+tilting and the gripper go through joint trajectories checked against joint
+states; navigating and approaching through a goal pose whose completion is
+judged from odometry. A skill with a ROS 2 binding publishes, calls or sends a
+trajectory as its binding says (`bindings.py`, docs/skills.md).
 
 Safety rules, each enforced in one place:
 - every base motion ends in a zero Twist, however it ends (done, cancel,
@@ -21,13 +24,15 @@ import threading
 import time
 from collections.abc import Callable
 
-from agent.robot import CancelToken, Outcome, Pose, RobotState
+from agent.executor import navigate_point
+from agent.robot import CancelToken, Outcome, Pose, RobotState, approach_first
+from agent.ros2.bindings import BindingFailure, BoundSkills
 from agent.ros2.config import RosConfig
 from agent.ros2.geometry import footprint_radius, wrap_angle
-from agent.ros2.link import Odometry, RobotLink, ServiceError
+from agent.ros2.link import Odometry, RobotLink, ServiceError, primitives_used
 from agent.ros2.messages import Footprint, FormatError, decode_held, decode_objects
 from agent.ros2.motion import Limits, move_budget, next_speed
-from rsl.profile import Profile
+from rsl.profile import Profile, RosBinding, Skill
 
 CONTROL_PERIOD = 0.02  # s, 50 Hz: well inside the 0.2 s the robot has to stop after a cancel
 LINEAR_TOLERANCE = 0.002  # m; the contract is 2 cm, the rest is margin for coasting
@@ -66,7 +71,8 @@ class Ros2Robot:
         self._generation = 0
         self._publish_lock = threading.Lock()
         self._closed = False
-        self._link = RobotLink(self.config, node_name)
+        self._link = RobotLink(self.config, node_name, primitives_used(profile))
+        self._bound = BoundSkills(self._link, profile)
         wait = self.config.connect_timeout if connect_timeout is None else connect_timeout
         if self._link.wait_for_odometry(wait) is None:
             self._link.close()
@@ -77,102 +83,97 @@ class Ros2Robot:
                 f"(try `ros2 topic hz {self.config.odom}`)."
             )
 
-    # -- skills: base ------------------------------------------------------------
+    # -- skills, by binding --------------------------------------------------------
 
-    def forward(self, distance: float, *, cancel: CancelToken | None = None) -> Outcome:
-        return self._guarded(cancel, lambda token: self._drive(distance, 1.0, token))
+    def perform(self, skill: Skill, args: tuple[float | str, ...], *,
+                cancel: CancelToken | None = None) -> Outcome:
+        """Run `skill` by its binding: a robot primitive, or its ROS 2 topic, service or trajectory."""
+        binding = skill.binding
+        if isinstance(binding, RosBinding):
+            ros = binding
+            return self._guarded(cancel, lambda token: self._bound.perform(skill.keyword, ros, skill.params,
+                                                                           args, token))
+        if binding is None:
+            return Outcome.failed(f"the ROS 2 backend cannot run `{skill.keyword}`: it declares no binding in "
+                                  f"profile {self.profile.name}")
+        sign, statement = binding.sign, f"`{skill.keyword}{' ' if args else ''}{', '.join(map(str, args))};`"
+        if binding.name == "drive":
+            return self._guarded(cancel, lambda token: self._drive(float(args[0]), sign, token, statement))
+        if binding.name == "turn":
+            return self._guarded(cancel, lambda token: self._turn(float(args[0]), sign, token, statement))
+        if binding.name == "pan":
+            return self._guarded(cancel, lambda token: self._look(sign * float(args[0]), 0.0, token))
+        if binding.name == "tilt":
+            return self._guarded(cancel, lambda token: self._look(0.0, sign * float(args[0]), token))
+        if binding.name == "navigate":
+            x, y = navigate_point(skill, [float(a) for a in args])
+            return self._guarded(cancel, lambda token: self._navigate(x, y, token, statement))
+        if binding.name == "approach_object":
+            return self._guarded(cancel, lambda token: self._approach(str(args[0]), token))
+        if binding.name == "perceive_objects":
+            return self._guarded(cancel, self._perceive)
+        return self._guarded(cancel, lambda token: self._grasp(str(args[0]), token))
 
-    def backward(self, distance: float, *, cancel: CancelToken | None = None) -> Outcome:
-        return self._guarded(cancel, lambda token: self._drive(distance, -1.0, token))
+    def _navigate(self, x: float, y: float, token: CancelToken, statement: str) -> Outcome:
+        self._check_workspace(x, y, statement)
+        start = self._fresh_odometry().pose
+        far = math.hypot(x - start.x, y - start.y)
+        heading = math.atan2(y - start.y, x - start.x) if far > self.config.goal_tolerance else start.heading
+        self._drive_to_goal(x, y, heading, token)
+        here = self._fresh_odometry().pose
+        return Outcome.done(f"at ({here.x:.2f}, {here.y:.2f})")
 
-    def turnleft(self, angle: float, *, cancel: CancelToken | None = None) -> Outcome:
-        return self._guarded(cancel, lambda token: self._turn(angle, 1.0, token))
+    def _approach(self, name: str, token: CancelToken) -> Outcome:
+        ox, oy = self._object_position(name, token)
+        here = self._fresh_odometry().pose
+        away = math.hypot(ox - here.x, oy - here.y)
+        heading = math.atan2(oy - here.y, ox - here.x) if away > 1e-3 else here.heading
+        standoff = self.profile.motion.standoff + self._edge(name, heading + math.pi)
+        x, y = ox - standoff * math.cos(heading), oy - standoff * math.sin(heading)
+        self._check_workspace(x, y, f"the stand-off point in front of {name}")
+        self._drive_to_goal(x, y, heading, token)
+        # Navigation stacks settle headings loosely (Nav2: 0.25 rad by default), so the
+        # final turn to face the object is closed loop on odometry like any turn.
+        here = self._fresh_odometry().pose
+        facing = math.atan2(oy - here.y, ox - here.x)
+        error = wrap_angle(facing - here.heading)
+        if abs(error) > ANGULAR_TOLERANCE:
+            self._turn(abs(error), math.copysign(1.0, error), token, f"the turn to face {name}")
+        return Outcome.done(f"stopped {self.profile.motion.standoff:g} m in front of {name}, facing it")
 
-    def turnright(self, angle: float, *, cancel: CancelToken | None = None) -> Outcome:
-        return self._guarded(cancel, lambda token: self._turn(angle, -1.0, token))
+    def _perceive(self, token: CancelToken) -> Outcome:
+        reply = self._link.call_perceive(token)
+        if not reply.success:
+            raise StepFailure(f"perception failed: {reply.message}")
+        report = decode_objects(reply.message, f"reply of {self.config.perceive_service}")
+        seen = report.objects
+        self._known.update(seen)
+        self._footprints.update(report.footprints)
+        if not seen:
+            return Outcome.done("saw no objects")
+        return Outcome.done("saw " + ", ".join(sorted(seen)))
 
-    def goto(self, x: float, y: float, *, cancel: CancelToken | None = None) -> Outcome:
-        def run(token: CancelToken) -> Outcome:
-            self._check_workspace(x, y, f"goto {x:g}, {y:g}")
-            start = self._fresh_odometry().pose
-            far = math.hypot(x - start.x, y - start.y)
-            heading = math.atan2(y - start.y, x - start.x) if far > self.config.goal_tolerance else start.heading
-            self._drive_to_goal(x, y, heading, token)
-            here = self._fresh_odometry().pose
-            return Outcome.done(f"at ({here.x:.2f}, {here.y:.2f})")
-        return self._guarded(cancel, run)
-
-    def approach(self, name: str, *, cancel: CancelToken | None = None) -> Outcome:
-        def run(token: CancelToken) -> Outcome:
-            ox, oy = self._object_position(name, token)
-            here = self._fresh_odometry().pose
-            away = math.hypot(ox - here.x, oy - here.y)
-            heading = math.atan2(oy - here.y, ox - here.x) if away > 1e-3 else here.heading
-            standoff = self.profile.motion.standoff + self._edge(name, heading + math.pi)
-            x, y = ox - standoff * math.cos(heading), oy - standoff * math.sin(heading)
-            self._check_workspace(x, y, f"the stand-off point in front of {name}")
-            self._drive_to_goal(x, y, heading, token)
-            # Navigation stacks settle headings loosely (Nav2: 0.25 rad by default), so the
-            # final turn to face the object is closed loop on odometry like any turn.
-            here = self._fresh_odometry().pose
-            facing = math.atan2(oy - here.y, ox - here.x)
-            error = wrap_angle(facing - here.heading)
-            if abs(error) > ANGULAR_TOLERANCE:
-                self._turn(abs(error), math.copysign(1.0, error), token)
-            return Outcome.done(f"stopped {self.profile.motion.standoff:g} m in front of {name}, facing it")
-        return self._guarded(cancel, run)
-
-    # -- skills: head, perception, gripper ---------------------------------------
-
-    def lookleft(self, angle: float, *, cancel: CancelToken | None = None) -> Outcome:
-        return self._guarded(cancel, lambda token: self._look(angle, 0.0, token))
-
-    def lookright(self, angle: float, *, cancel: CancelToken | None = None) -> Outcome:
-        return self._guarded(cancel, lambda token: self._look(-angle, 0.0, token))
-
-    def lookup(self, angle: float, *, cancel: CancelToken | None = None) -> Outcome:
-        return self._guarded(cancel, lambda token: self._look(0.0, angle, token))
-
-    def lookdown(self, angle: float, *, cancel: CancelToken | None = None) -> Outcome:
-        return self._guarded(cancel, lambda token: self._look(0.0, -angle, token))
-
-    def perceive(self, *, cancel: CancelToken | None = None) -> Outcome:
-        def run(token: CancelToken) -> Outcome:
-            reply = self._link.call_perceive(token)
-            if not reply.success:
-                raise StepFailure(f"perception failed: {reply.message}")
-            report = decode_objects(reply.message, f"reply of {self.config.perceive_service}")
-            seen = report.objects
-            self._known.update(seen)
-            self._footprints.update(report.footprints)
-            if not seen:
-                return Outcome.done("saw no objects")
-            return Outcome.done("saw " + ", ".join(sorted(seen)))
-        return self._guarded(cancel, run)
-
-    def grasp(self, name: str, *, cancel: CancelToken | None = None) -> Outcome:
-        def run(token: CancelToken) -> Outcome:
-            if self._holding_now() is not None:
-                raise StepFailure(f"cannot grasp {name}: already holding {self._holding_now()}; "
-                                  "the gripper holds one object at a time")
-            ox, oy = self._object_position(name, token)
-            here = self._fresh_odometry().pose
-            away = math.hypot(ox - here.x, oy - here.y)
-            reach = self.profile.motion.reach
-            if away > reach:
-                raise StepFailure(f"{name} is {away:.2f} m away, out of reach {reach:g} m; "
-                                  f"`approach {name};` first")
-            self._check_nearest(name, away, here)
-            self._move_gripper(self.config.gripper_open_position, token)
-            reply = self._link.call_grasp(token)
-            if not reply.success:
-                raise StepFailure(f"grasping {name} failed: {reply.message}")
-            held = decode_held(reply.message, f"reply of {self.config.grasp_service}")
-            self._holding, self._held_since = held, time.monotonic()
-            if held != name:
-                raise StepFailure(f"the gripper closed on {held}, not {name}")
-            return Outcome.done(f"holding {name}")
-        return self._guarded(cancel, run)
+    def _grasp(self, name: str, token: CancelToken) -> Outcome:
+        if self._holding_now() is not None:
+            raise StepFailure(f"cannot grasp {name}: already holding {self._holding_now()}; "
+                              "the gripper holds one object at a time")
+        ox, oy = self._object_position(name, token)
+        here = self._fresh_odometry().pose
+        away = math.hypot(ox - here.x, oy - here.y)
+        reach = self.profile.motion.reach
+        if away > reach:
+            raise StepFailure(f"{name} is {away:.2f} m away, out of reach {reach:g} m; "
+                              f"{approach_first(self.profile, name)}")
+        self._check_nearest(name, away, here)
+        self._move_gripper(self.config.gripper_open_position, token)
+        reply = self._link.call_grasp(token)
+        if not reply.success:
+            raise StepFailure(f"grasping {name} failed: {reply.message}")
+        held = decode_held(reply.message, f"reply of {self.config.grasp_service}")
+        self._holding, self._held_since = held, time.monotonic()
+        if held != name:
+            raise StepFailure(f"the gripper closed on {held}, not {name}")
+        return Outcome.done(f"holding {name}")
 
     # -- the rest of the robot interface -------------------------------------------
 
@@ -190,7 +191,7 @@ class Ros2Robot:
 
     def state(self) -> RobotState:
         """Pose from odometry, head from joint states, and as known objects everything the
-        robot reports on its objects topic plus what `perceive` has seen."""
+        robot reports on its objects topic plus what perceiving has seen."""
         odom = self._link.odometry()
         pose = odom.pose if odom is not None else Pose(0.0, 0.0, 0.0)
         joints, _ = self._link.joints()
@@ -207,16 +208,15 @@ class Ros2Robot:
         )
 
     def __getattr__(self, name: str) -> Callable[..., Outcome]:
-        # A skill added to the profile but not taught to this backend fails as a step
-        # with a reason, rather than crashing the executor with an AttributeError.
+        # `robot.<keyword>(...)` for every skill of the profile, as generated Python and tests call it.
         profile = self.__dict__.get("profile")
-        if profile is None or profile.skill(name) is None:
+        skill = profile.skill(name) if profile is not None else None
+        if skill is None:
             raise AttributeError(name)
 
-        def unsupported(*_args: object, cancel: CancelToken | None = None) -> Outcome:
-            return Outcome.failed(f"the ROS 2 backend has no implementation of the skill `{name}` "
-                                  f"from profile {profile.name}; add it to agent/ros2/backend.py")
-        return unsupported
+        def run(*args: float | str, cancel: CancelToken | None = None) -> Outcome:
+            return self.perform(skill, args, cancel=cancel)
+        return run
 
     def close(self) -> None:
         if self._closed:
@@ -250,7 +250,7 @@ class Ros2Robot:
             return body(token)
         except _Cancelled as exc:
             return Outcome.cancelled(str(exc))
-        except (StepFailure, ServiceError, FormatError) as exc:
+        except (StepFailure, BindingFailure, ServiceError, FormatError) as exc:
             return Outcome.failed(str(exc))
         except Exception as exc:  # the robot must stop whatever went wrong
             return Outcome.failed(f"internal error in the ROS 2 backend: {type(exc).__name__}: {exc}")
@@ -258,7 +258,7 @@ class Ros2Robot:
             with self._publish_lock:
                 self._link.send_zero_twist()
 
-    def _drive(self, distance: float, direction: float, token: CancelToken) -> Outcome:
+    def _drive(self, distance: float, direction: float, token: CancelToken, what: str) -> Outcome:
         start = self._fresh_odometry().pose
         ux, uy = math.cos(start.heading), math.sin(start.heading)
 
@@ -272,11 +272,10 @@ class Ros2Robot:
 
         budget = move_budget(distance, self._linear.max_speed, self._linear.max_accel,
                              self.profile.motion.timeout_margin)
-        self._control(distance, progress, command, self._linear, LINEAR_TOLERANCE, budget, token,
-                      what=f"{'forward' if direction > 0 else 'backward'} {distance:g} m")
+        self._control(distance, progress, command, self._linear, LINEAR_TOLERANCE, budget, token, what)
         return Outcome.done()
 
-    def _turn(self, angle: float, direction: float, token: CancelToken) -> Outcome:
+    def _turn(self, angle: float, direction: float, token: CancelToken, what: str) -> Outcome:
         last = [self._fresh_odometry().pose.heading]
         turned = [0.0]
 
@@ -291,8 +290,7 @@ class Ros2Robot:
 
         budget = move_budget(angle, self._angular.max_speed, self._angular.max_accel,
                              self.profile.motion.timeout_margin)
-        self._control(angle, progress, command, self._angular, ANGULAR_TOLERANCE, budget, token,
-                      what=f"turn{'left' if direction > 0 else 'right'} {angle:g} rad")
+        self._control(angle, progress, command, self._angular, ANGULAR_TOLERANCE, budget, token, what)
         return Outcome.done()
 
     def _control(self, amount: float, progress: Callable[[Pose], float],
@@ -482,8 +480,8 @@ class Ros2Robot:
             return found
         if error:
             return self._unknown_object(name)
-        # Look before refusing, as the simulator does: a person who says "grasp
-        # the cup" expects the robot to use its camera if the cup is in view.
+        # Look before refusing, as the simulator does: a person who asks for the
+        # cup expects the robot to use its camera if the cup is in view.
         reply = self._link.call_perceive(token)
         if reply.success:
             report = decode_objects(reply.message, f"reply of {self.config.perceive_service}")
@@ -528,7 +526,7 @@ class Ros2Robot:
         for other, (x, y) in report.objects.items():
             if other != name and other != report.held and math.hypot(x - here.x, y - here.y) < away:
                 raise StepFailure(f"{other} is nearer to the gripper than {name}, so the grasp would "
-                                  f"take {other}; `approach {name};` first")
+                                  f"take {other}; {approach_first(self.profile, name)}")
 
     def _check_workspace(self, x: float, y: float, what: str) -> None:
         (xlo, xhi), (ylo, yhi) = self.profile.workspace["x"], self.profile.workspace["y"]

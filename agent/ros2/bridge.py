@@ -4,7 +4,8 @@ It plays the robot's drivers: a base controller on cmd_vel (with a command
 timeout, as diff-drive controllers have), odometry and joint states at a fixed
 rate, joint trajectory controllers for the head and gripper, a goal-pose
 follower, and the perceive and grasp services and objects topic that
-docs/ros2.md defines. The backend cannot tell it from a robot.
+docs/ros2.md defines, each only when a skill of the profile is bound to the
+primitive that uses it. The backend cannot tell it from a robot.
 
 All callbacks and the physics run on the one executor thread, so the world is
 never touched from two threads at once.
@@ -20,6 +21,7 @@ from typing import Any
 from agent.ros2.config import RosConfig
 from agent.ros2.geometry import quaternion_from_yaw, wrap_angle, yaw_from_quaternion
 from agent.ros2.goal_follower import Goal, GoalFollower
+from agent.ros2.link import primitives_used
 from agent.ros2.messages import Footprint, encode_held, encode_objects
 from agent.ros2.node_thread import NodeThread
 from agent.sim.world import GRASP_BEARING, SimWorld
@@ -59,15 +61,30 @@ class SimBridge:
         node = self._ros.node
         reliable = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
         cfg = self.config
+        # The drivers of the primitives the profile's skills are bound to, and no others: a
+        # base-only robot's bridge offers no head or gripper. Skills bound to ROS 2 directly are
+        # the robot's own interfaces, which the simulator does not model.
+        used = primitives_used(profile)
+        self._head_joints = bool(used & {"pan", "tilt"})
+        self._has_gripper = "grasp_object" in used
         self._odom = node.create_publisher(Odometry, cfg.odom, reliable)
         self._joints = node.create_publisher(JointState, cfg.joint_states, reliable)
         self._objects = node.create_publisher(String, cfg.objects_topic, reliable)
         node.create_subscription(Twist, cfg.cmd_vel, self._on_cmd_vel, reliable)
-        node.create_subscription(PoseStamped, cfg.goal_pose, self._on_goal, reliable)
-        node.create_subscription(JointTrajectory, cfg.head_trajectory, self._on_head, reliable)
-        node.create_subscription(JointTrajectory, cfg.gripper_trajectory, self._on_gripper, reliable)
-        node.create_service(Trigger, cfg.perceive_service, self._on_perceive)
-        node.create_service(Trigger, cfg.grasp_service, self._on_grasp)
+        self.interfaces = [cfg.cmd_vel, cfg.odom, cfg.joint_states, cfg.objects_topic]
+        if used & {"navigate", "approach_object"}:
+            node.create_subscription(PoseStamped, cfg.goal_pose, self._on_goal, reliable)
+            self.interfaces.append(cfg.goal_pose)
+        if self._head_joints:
+            node.create_subscription(JointTrajectory, cfg.head_trajectory, self._on_head, reliable)
+            self.interfaces.append(cfg.head_trajectory)
+        if self._has_gripper:
+            node.create_subscription(JointTrajectory, cfg.gripper_trajectory, self._on_gripper, reliable)
+            node.create_service(Trigger, cfg.grasp_service, self._on_grasp)
+            self.interfaces += [cfg.gripper_trajectory, cfg.grasp_service]
+        if used & {"perceive_objects", "approach_object"}:
+            node.create_service(Trigger, cfg.perceive_service, self._on_perceive)
+            self.interfaces.append(cfg.perceive_service)
         node.create_service(Trigger, RESET_SERVICE, self._on_reset)
         self._timer = node.create_timer(1.0 / PUBLISH_HZ, self._tick)
 
@@ -129,8 +146,15 @@ class SimBridge:
         pan, tilt = world.head()
         joints = self._joint_state_type()
         joints.header.stamp = stamp
-        joints.name = [cfg.head_pan_joint, cfg.head_tilt_joint, cfg.gripper_joint]
-        joints.position = [float(pan), float(tilt), float(self._gripper)]
+        names: list[str] = []
+        positions: list[float] = []
+        if self._head_joints:
+            names += [cfg.head_pan_joint, cfg.head_tilt_joint]
+            positions += [float(pan), float(tilt)]
+        if self._has_gripper:
+            names.append(cfg.gripper_joint)
+            positions.append(float(self._gripper))
+        joints.name, joints.position = names, positions
         self._joints.publish(joints)
 
     def _publish_objects(self) -> None:

@@ -23,7 +23,7 @@ def footprint_radius(shape: str, size: tuple[float, float], yaw: float, directio
     """Distance from an object's centre to its edge, seen along `direction` (world frame).
 
     Boxes are measured along the ray; round shapes by their radius. This is the
-    convention the simulator's scenes use, so `approach table;` stops at the
+    convention the simulator's scenes use, so approaching a table stops at the
     same place on both backends.
     """
     if shape != "box":

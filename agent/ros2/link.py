@@ -11,12 +11,14 @@ import math
 import threading
 import time
 from dataclasses import dataclass
+from typing import Any
 
 from agent.robot import CancelToken, Pose
 from agent.ros2.config import RosConfig
 from agent.ros2.geometry import quaternion_from_yaw, yaw_from_quaternion
 from agent.ros2.messages import FormatError, ObjectReport, decode_objects
 from agent.ros2.node_thread import NodeThread
+from rsl.profile import PRIMITIVES, Primitive, Profile
 
 
 @dataclass(frozen=True)
@@ -38,7 +40,8 @@ class ServiceError(RuntimeError):
 
 
 class RobotLink:
-    def __init__(self, config: RosConfig, node_name: str = "nrtrans_backend") -> None:
+    def __init__(self, config: RosConfig, node_name: str = "nrtrans_backend",
+                 primitives: frozenset[str] = frozenset(PRIMITIVES)) -> None:
         from geometry_msgs.msg import PoseStamped, Twist
         from nav_msgs.msg import Odometry as OdometryMsg
         from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
@@ -64,10 +67,17 @@ class RobotLink:
         self._twist_type = Twist
         self._pose_type = PoseStamped
         self._trajectory_type = JointTrajectory
+        self._reliable = reliable
+        # Only the interfaces the profile's primitives use: a base-only robot offers no head topic.
         self._cmd_vel = node.create_publisher(Twist, config.cmd_vel, reliable)
-        self._goal = node.create_publisher(PoseStamped, config.goal_pose, reliable)
-        self._head = node.create_publisher(JointTrajectory, config.head_trajectory, reliable)
-        self._gripper = node.create_publisher(JointTrajectory, config.gripper_trajectory, reliable)
+        self._publishers: dict[str, Any] = {"cmd_vel": self._cmd_vel}
+        if primitives & {"navigate", "approach_object"}:
+            self._publishers["goal"] = node.create_publisher(PoseStamped, config.goal_pose, reliable)
+        if primitives & {"pan", "tilt"}:
+            self._publishers["head"] = node.create_publisher(JointTrajectory, config.head_trajectory, reliable)
+        if "grasp_object" in primitives:
+            self._publishers["gripper"] = node.create_publisher(JointTrajectory, config.gripper_trajectory,
+                                                                reliable)
         # Best-effort subscriptions match both reliable and best-effort publishers,
         # which is what real robot drivers use for these streams.
         node.create_subscription(OdometryMsg, config.odom, self._on_odom, qos_profile_sensor_data)
@@ -75,7 +85,8 @@ class RobotLink:
         node.create_subscription(String, config.objects_topic, self._on_objects,
                                  QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT))
         self._perceive = node.create_client(Trigger, config.perceive_service)
-        self._grasp = node.create_client(Trigger, config.grasp_service)
+        self._grasp = (node.create_client(Trigger, config.grasp_service) if "grasp_object" in primitives
+                       else None)
         self._trigger_request = Trigger.Request
 
     # -- incoming --------------------------------------------------------------
@@ -168,17 +179,26 @@ class RobotLink:
         qx, qy, qz, qw = quaternion_from_yaw(heading)
         msg.pose.orientation.x, msg.pose.orientation.y = qx, qy
         msg.pose.orientation.z, msg.pose.orientation.w = qz, qw
-        self._goal.publish(msg)
+        goal = self._publishers.get("goal")
+        if goal is not None:
+            goal.publish(msg)
 
     def send_head(self, pan: float, tilt: float, duration: float) -> None:
-        self._send_trajectory(self._head, [self.config.head_pan_joint, self.config.head_tilt_joint],
-                              [pan, tilt], duration)
+        self.send_trajectory(self._publishers["head"], [self.config.head_pan_joint, self.config.head_tilt_joint],
+                             [pan, tilt], duration)
 
     def send_gripper(self, position: float, duration: float) -> None:
-        self._send_trajectory(self._gripper, [self.config.gripper_joint], [position], duration)
+        self.send_trajectory(self._publishers["gripper"], [self.config.gripper_joint], [position], duration)
 
-    def _send_trajectory(self, publisher: object, joints: list[str], positions: list[float],
-                         duration: float) -> None:
+    def publisher(self, msg_type: Any, topic: str) -> Any:
+        """A reliable publisher on `topic`, for a skill bound to a topic or joint trajectory."""
+        return self._ros.node.create_publisher(msg_type, topic, self._reliable)
+
+    def client(self, srv_type: Any, service: str) -> Any:
+        return self._ros.node.create_client(srv_type, service)
+
+    def send_trajectory(self, publisher: object, joints: list[str], positions: list[float],
+                        duration: float) -> None:
         from builtin_interfaces.msg import Duration
         from trajectory_msgs.msg import JointTrajectoryPoint
 
@@ -194,17 +214,18 @@ class RobotLink:
         publisher.publish(msg)  # type: ignore[attr-defined]
 
     def call_perceive(self, cancel: CancelToken) -> ServiceReply:
-        return self._call(self._perceive, self.config.perceive_service, cancel)
+        return self.call(self._perceive, self.config.perceive_service, cancel)
 
     def call_grasp(self, cancel: CancelToken) -> ServiceReply:
-        return self._call(self._grasp, self.config.grasp_service, cancel)
+        return self.call(self._grasp, self.config.grasp_service, cancel)
 
-    def _call(self, client: object, name: str, cancel: CancelToken) -> ServiceReply:
+    def call(self, client: object, name: str, cancel: CancelToken, request: object | None = None) -> ServiceReply:
+        """Call a service whose response has `success` and `message` (std_srvs Trigger, SetBool)."""
         timeout = self.config.service_timeout
         if not client.wait_for_service(timeout_sec=min(timeout, 2.0)):  # type: ignore[attr-defined]
             raise ServiceError(f"service {name} is not available; is the robot's driver "
                                "(or `nrtrans sim-bridge`) running and offering it?")
-        future = client.call_async(self._trigger_request())  # type: ignore[attr-defined]
+        future = client.call_async(request or self._trigger_request())  # type: ignore[attr-defined]
         answered = threading.Event()
         future.add_done_callback(lambda _f: answered.set())
         deadline = time.monotonic() + timeout
@@ -219,15 +240,18 @@ class RobotLink:
 
     def listeners(self, publisher: str) -> int:
         """How many subscriptions match one of our publishers: cmd_vel, goal, head or gripper."""
-        chosen = {"cmd_vel": self._cmd_vel, "goal": self._goal, "head": self._head,
-                  "gripper": self._gripper}[publisher]
-        return int(chosen.get_subscription_count())
+        return int(self._publishers[publisher].get_subscription_count())
 
     def close(self) -> None:
         # After this, sends are no-ops: a step still unwinding in another thread
         # must not publish through a destroyed node.
         self._closed = True
         self._ros.close()
+
+
+def primitives_used(profile: Profile) -> frozenset[str]:
+    """The robot primitives the profile's skills are bound to."""
+    return frozenset(s.binding.name for s in profile.skills if isinstance(s.binding, Primitive))
 
 
 def distance(a: Pose, x: float, y: float) -> float:

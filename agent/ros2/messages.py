@@ -9,7 +9,7 @@ functions, so the two sides cannot drift apart.
 - objects topic (std_msgs/String):
   `{"frame": "odom", "objects": {"cup": {"x": 1.0, "y": 0.5, "z": 0.8}}, "held": "cup"}`;
   an object may add its footprint, `"footprint": {"shape": "box", "size": [0.8, 1.2], "yaw": 0.0}`
-  (shape box, cylinder or sphere), so `approach` keeps its stand-off from the
+  (shape box, cylinder or sphere), so approaching keeps its stand-off from the
   object's edge rather than its centre.
 - perceive service (std_srvs/Trigger), on success the response message is
   `{"frame": "odom", "objects": {"cup": {"x": 1.0, "y": 0.5}}}` (the objects in view,

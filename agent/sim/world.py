@@ -445,10 +445,17 @@ class SimWorld:
 
     # -- pictures -----------------------------------------------------------------------------------
 
-    def camera_image(self, width: int = 320, height: int = 240) -> np.ndarray:
-        """What the head camera sees now, as an RGB array (TinyRenderer; works headless)."""
+    def camera_image(self, width: int = 320, height: int = 240, *,
+                     look_at: tuple[float, float, float] | None = None) -> np.ndarray:
+        """What the head camera sees now, as an RGB array (TinyRenderer; works headless).
+
+        With `look_at`, the camera is aimed from where it is at that point instead (the pictures
+        of a step that acts on an object show the object even when the head looks past it).
+        """
         eye, rotation = self.camera_pose()
         forward, up = rotation[:, 0], rotation[:, 2]
+        if look_at is not None:
+            forward, up = np.asarray(look_at, dtype=float) - eye, np.array([0.0, 0.0, 1.0])
         view = self._client.computeViewMatrix(eye.tolist(), (eye + forward).tolist(), up.tolist())
         projection = self._client.computeProjectionMatrixFOV(math.degrees(CAMERA_VFOV), width / height,
                                                              0.05, CAMERA_RANGE * 2)

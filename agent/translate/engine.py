@@ -15,13 +15,25 @@ import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
 from agent.translate.automaton import ALPHABET, END, RslAutomaton, State
 
 _OPEN_LOCK = threading.Lock()
+# How often a generation looks at its caller's cancel flag while llama.cpp computes.
+_CANCEL_POLL_S = 0.01
+
+
+class CancelFlag(Protocol):
+    """Anything with `is_set()`: a `threading.Event`, the robot's `CancelToken`."""
+
+    def is_set(self) -> bool: ...
+
+
+class GenerationCancelled(Exception):
+    """The caller's cancel flag was set while the model was generating."""
 
 
 @dataclass(frozen=True)
@@ -80,6 +92,34 @@ def open_llama(path: Path, *, n_ctx: int = 2048, lora_path: Path | None = None, 
     use_plain_cpu_buffers()
     return llama_cpp.Llama(model_path=str(path), n_ctx=n_ctx, n_batch=512, verbose=False,
                            lora_path=None if lora_path is None else str(lora_path), n_threads=n_threads)
+
+
+class _AbortFlag:
+    """llama.cpp's abort callback, answered without Python: a C string that is empty or not.
+
+    The callback runs between the nodes of every compute graph. A Python callback
+    would take the GIL hundreds of times per token; libc's `strlen` on this buffer
+    answers "abort?" (0 or 1, read as a C bool) with no Python at all.
+    """
+
+    def __init__(self, llm: Any) -> None:
+        import llama_cpp
+
+        self._buffer = ctypes.create_string_buffer(2)
+        strlen = ctypes.cast(ctypes.CDLL(None).strlen, ctypes.c_void_p).value
+        assert strlen is not None, "libc has strlen"
+        # Kept referenced: llama.cpp holds only the raw pointers.
+        self._callback = llama_cpp.ggml_abort_callback(strlen)
+        llama_cpp.llama_set_abort_callback(llm._ctx.ctx, self._callback, ctypes.cast(self._buffer, ctypes.c_void_p))
+
+    def set(self) -> None:
+        self._buffer[0] = b"x"
+
+    def clear(self) -> None:
+        self._buffer[0] = b"\0"
+
+    def is_set(self) -> bool:
+        return self._buffer[0] != b"\0"
 
 
 class _Trie:
@@ -171,6 +211,7 @@ class LocalEngine:
         self.vocabulary = Vocabulary(self.llm)
         self.chat_template: str = self.llm.metadata.get("tokenizer.chat_template", "")
         self._masks: dict[Any, TokenMasks] = {}
+        self._abort = _AbortFlag(self.llm)
 
     def masks(self, automaton: RslAutomaton) -> TokenMasks:
         masks = self._masks.get(automaton.key)
@@ -180,8 +221,41 @@ class LocalEngine:
             masks = self._masks[automaton.key] = TokenMasks(automaton, self.vocabulary)
         return masks
 
-    def generate(self, prompt: str, automaton: RslAutomaton | None, max_tokens: int) -> Generation:
+    def generate(self, prompt: str, automaton: RslAutomaton | None, max_tokens: int,
+                 cancel: CancelFlag | None = None) -> Generation:
+        """Raises `GenerationCancelled` within milliseconds of `cancel` being set, even mid-token."""
+        if cancel is None:
+            return self._generate(prompt, automaton, max_tokens)
+        if cancel.is_set():
+            raise GenerationCancelled("generation cancelled")
+        done = threading.Event()
+
+        def watch() -> None:
+            # One llama_decode call can take a second on a loaded CPU; the abort flag ends it early.
+            while not done.wait(_CANCEL_POLL_S):
+                if cancel.is_set():
+                    self._abort.set()
+                    return
+
+        watcher = threading.Thread(target=watch, name="nrtrans-cancel-watch", daemon=True)
+        watcher.start()
+        try:
+            return self._generate(prompt, automaton, max_tokens)
+        except RuntimeError:
+            if self._abort.is_set():
+                raise GenerationCancelled("generation cancelled") from None
+            raise
+        finally:
+            done.set()
+            watcher.join()
+            self._abort.clear()
+
+    def _generate(self, prompt: str, automaton: RslAutomaton | None, max_tokens: int) -> Generation:
         import llama_cpp
+
+        def check() -> None:
+            if self._abort.is_set():
+                raise GenerationCancelled("generation cancelled")
 
         llm = self.llm
         started = time.perf_counter()
@@ -208,6 +282,7 @@ class LocalEngine:
         first_piece, first_probability = "", 0.0
         chosen: list[float] = []
         while generated < max_tokens:
+            check()
             logits = np.ctypeslib.as_array(llama_cpp.llama_get_logits_ith(llm._ctx.ctx, -1), shape=(n_vocab,))
             if generated == 0:
                 top = int(np.argmax(logits))

@@ -9,7 +9,7 @@ import urllib.request
 from typing import Any
 
 from agent.translate.automaton import RslAutomaton
-from agent.translate.engine import Generation
+from agent.translate.engine import CancelFlag, Generation, GenerationCancelled
 
 
 class EndpointError(RuntimeError):
@@ -31,7 +31,11 @@ class HttpEngine:
         base = self.endpoint[:-3] if self.endpoint.endswith("/v1") else self.endpoint
         self._url = f"{base}/v1/completions"
 
-    def generate(self, prompt: str, automaton: RslAutomaton | None, max_tokens: int) -> Generation:
+    def generate(self, prompt: str, automaton: RslAutomaton | None, max_tokens: int,
+                 cancel: CancelFlag | None = None) -> Generation:
+        if cancel is not None and cancel.is_set():
+            # One request cannot be interrupted; a cancel takes effect before the next.
+            raise GenerationCancelled("generation cancelled")
         body: dict[str, Any] = {"prompt": prompt, "max_tokens": max_tokens, "temperature": 0.0,
                                 "top_k": 1, "seed": 0}
         if self.model:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import difflib
 import itertools
+import logging
 import re
 import threading
 import time
@@ -23,7 +24,7 @@ from agent.normalize import normalize_task
 from agent.translate.automaton import RslAutomaton
 from agent.translate.clauses import Clause, split_clauses
 from agent.translate.confidence import judge
-from agent.translate.engine import Generation
+from agent.translate.engine import CancelFlag, Generation
 from agent.translate.model_path import ModelNotFoundError
 from agent.translate.prompt import (
     Shot,
@@ -39,6 +40,10 @@ from rsl.compiler import compile_program
 from rsl.diagnostics import Code, Diagnostic
 from rsl.plan import Quantity, format_number
 from rsl.profile import Convention, Profile
+from rsl.syntax import NO_PROGRAM
+
+# What the loop does, for a person following along (`nrtrans translate -v`, or log_level = "debug").
+progress = logging.getLogger("nrtrans.translate")
 
 MAX_TOKENS = 160
 # One clause rarely needs more; a square is 8 statements.
@@ -61,7 +66,8 @@ _RANGE_CODES = frozenset({Code.OUT_OF_RANGE, Code.NOT_POSITIVE, Code.OUTSIDE_WOR
 class Engine(Protocol):
     chat_template: str
 
-    def generate(self, prompt: str, automaton: RslAutomaton | None, max_tokens: int) -> Generation: ...
+    def generate(self, prompt: str, automaton: RslAutomaton | None, max_tokens: int,
+                 cancel: CancelFlag | None = None) -> Generation: ...
 
     def close(self) -> None: ...
 
@@ -85,6 +91,9 @@ class Options:
     # Refuse a clause the model does not read as a robot task ("what time is it"): the grammar would
     # force some program out of it. Only with the adapter, whose first-token confidence was measured.
     refuse_unclear: bool = False
+    # Let the grammar offer NO_PROGRAM in place of statements, for a model trained to write it
+    # for words that are not a task; writing it refuses the clause with E201, without repair.
+    refusal: bool = False
 
 
 @dataclass
@@ -97,6 +106,7 @@ class _ClauseState:
     max_statements: int | None = None
     free_numbers: bool = False  # set after a range error, so the repair may pick any number
     unclear: tuple[str, float] | None = None  # (the model's first choice, its probability) when not a task
+    refused: bool = False  # the model wrote NO_PROGRAM
     lines: tuple[int, int] = (0, 0)
     timings: dict[str, float] = field(default_factory=dict)
     probabilities: tuple[float, ...] = ()  # the model's choices under the grammar, for the confidence
@@ -150,7 +160,7 @@ class Translator:
                           shots=(0 if use_adapter else DEFAULT_SHOTS) if shots is None else shots,
                           split_clauses=split_clauses, narrow=narrow, narrow_skills=not use_adapter,
                           adapter_prompt=use_adapter, prefix_shots=prefix_shots and not use_adapter,
-                          refuse_unclear=use_adapter)
+                          refuse_unclear=use_adapter, refusal=use_adapter)
         return cls(profile, engine, name, options)
 
     def close(self) -> None:
@@ -158,21 +168,30 @@ class Translator:
             self.engine.close()
 
     def translate(self, task: str, *, known_objects: Collection[str] | None = None,
-                  on_attempt: Callable[[Attempt], None] | None = None) -> TranslationResult:
+                  on_attempt: Callable[[Attempt], None] | None = None,
+                  cancel: CancelFlag | None = None) -> TranslationResult:
+        """`cancel` set mid-way raises `GenerationCancelled` from the model call."""
         with self._lock:
-            return self._translate(task, known_objects, on_attempt)
+            return self._translate(task, known_objects, on_attempt, cancel)
 
     def _translate(self, task: str, known: Collection[str] | None,
-                   on_attempt: Callable[[Attempt], None] | None) -> TranslationResult:
+                   on_attempt: Callable[[Attempt], None] | None, cancel: CancelFlag | None) -> TranslationResult:
         started = time.perf_counter()
         timings = {"prompt": 0.0, "generate": 0.0, "compile": 0.0}
         normalized = normalize_task(task)
         if not normalized:
             return TranslationResult(task=task, program="", verified=False, passes=0, attempts=(), plan=None,
                                      model=self.model_name, timings_ms={**timings, "total": 0.0})
+        beyond = self._beyond_robot(normalized)
+        if beyond is not None:
+            return TranslationResult(task=task, program="", verified=False, passes=0,
+                                     attempts=(Attempt(program="", diagnostics=(beyond,)),), plan=None,
+                                     model=self.model_name, timings_ms={**timings, "total": 0.0})
         clauses = (split_clauses(normalized, self.profile) if self.options.split_clauses
                    else [Clause(text=normalized)])
         states = [_ClauseState(c) for c in clauses]
+        progress.debug("task %r, normalized %r: %d clause(s): %s", task, normalized, len(clauses),
+                       " | ".join(repr(c.text) for c in clauses))
         for state in states:
             state.objects = self._task_objects(state.clause.text)
             if self.options.narrow and self.options.narrow_skills:
@@ -183,20 +202,27 @@ class Translator:
         for _ in range(self.options.max_passes):
             for state in pending:
                 prompt = self.prompt_for(state.clause.text, state.extra)
-                generation = self.engine.generate(prompt, self._automaton(state), MAX_TOKENS)
+                generation = self.engine.generate(prompt, self._automaton(state), MAX_TOKENS, cancel)
                 timings["prompt"] += generation.prompt_ms
                 timings["generate"] += generation.generate_ms
                 state.program = _tidy(generation.text)
                 state.probabilities = generation.token_probabilities
+                state.refused = self.options.refusal and state.program == NO_PROGRAM + "\n"
+                progress.debug("pass %d, clause %r -> %r (prompt %.0f ms, generation %.0f ms)", len(attempts) + 1,
+                               state.clause.text, state.program.strip(), generation.prompt_ms,
+                               generation.generate_ms)
                 if self.options.refuse_unclear and not attempts and not _reads_as_task(generation, self.profile):
                     state.unclear = (generation.first_piece, generation.first_probability or 0.0)
             program = _assemble(states)
             compile_started = time.perf_counter()
             result = compile_program(program, self.profile, known)
             timings["compile"] += (time.perf_counter() - compile_started) * 1000
-            unclear = [self._not_a_task(state) for state in states if state.unclear is not None]
+            unclear = [self._not_a_task(state) for state in states if state.unclear is not None or state.refused]
             attempt = Attempt(program=program, diagnostics=(*unclear, *result.diagnostics))
             attempts.append(attempt)
+            progress.debug("pass %d: %s", len(attempts), "verified" if attempt.ok else
+                           f"{len(attempt.diagnostics)} problem(s): " + "; ".join(
+                               f"line {d.line}: {d.message}" for d in attempt.diagnostics))
             if on_attempt is not None:
                 on_attempt(attempt)
             if unclear or result.ok:
@@ -213,6 +239,9 @@ class Translator:
             judged = judge(normalized, plan, self.profile, (p for s in states for p in s.probabilities), known)
             timings["checks"] = (time.perf_counter() - checks_started) * 1000
         timings["total"] = (time.perf_counter() - started) * 1000
+        progress.debug("%s after %d pass(es) in %.0f ms: prompt %.0f ms, generation %.0f ms, compile %.1f ms",
+                       "verified" if verified else "NOT verified", len(attempts), timings["total"],
+                       timings["prompt"], timings["generate"], timings["compile"])
         return TranslationResult(task=task, program=attempts[-1].program, verified=verified,
                                  passes=len(attempts), attempts=tuple(attempts),
                                  plan=plan, model=self.model_name, timings_ms=timings, **judged)
@@ -260,10 +289,11 @@ class Translator:
                 self._automata.clear()
             try:
                 automaton = RslAutomaton(self.profile, keywords=state.keywords, objects=state.objects,
-                                         numbers=numbers, max_statements=cap)
+                                         numbers=numbers, max_statements=cap, refusal=self.options.refusal)
             except ValueError:
                 # The narrowing left nothing (say, only object skills and no object): drop it.
-                automaton = RslAutomaton(self.profile, objects=state.objects, numbers=numbers)
+                automaton = RslAutomaton(self.profile, objects=state.objects, numbers=numbers,
+                                         refusal=self.options.refusal)
             self._automata[key] = automaton
         return automaton
 
@@ -342,16 +372,34 @@ class Translator:
                 names.append("_".join(words))
         return tuple(dict.fromkeys(names)) or None
 
+    def _beyond_robot(self, text: str) -> Diagnostic | None:
+        """A request for what the profile says this robot cannot do: refused before the model
+        can turn it into the nearest skill the robot has ("pick up the cup" into `approach cup;`)."""
+        found = self.profile.inability(text)
+        if found is None:
+            return None
+        inability, phrase = found
+        can = ", ".join(f"`{s.keyword}`" for s in self.profile.skills)
+        return Diagnostic(
+            code=Code.NOT_A_TASK, line=1, column=text.find(phrase) + 1, token=phrase,
+            message=f"'{text}' asks the {self.profile.name} robot to {phrase}, and it cannot {inability.what}. "
+                    f"Nothing was run. It can: {can}",
+            source_line=text)
+
     def _not_a_task(self, state: _ClauseState) -> Diagnostic:
-        assert state.unclear is not None
-        piece, probability = state.unclear
+        if state.refused:
+            reason = "the model wrote that it has no program for it"
+        else:
+            assert state.unclear is not None
+            piece, probability = state.unclear
+            reason = f"the model would begin with {piece.strip()!r}, {probability:.0%} sure"
         written = state.program.splitlines()[0] if state.program.strip() else ""
         examples = " or ".join(f"'{c.task}'" for c in self.profile.conventions[:2] if c.task)
         return Diagnostic(
             code=Code.NOT_A_TASK, line=state.lines[0], column=1, token=written or state.clause.text,
             message=f"'{state.clause.text}' does not read as a task for this robot, so nothing was run; "
                     f"say what it should do" + (f", for example {examples}" if examples else "")
-                    + f" (the model would begin with {piece.strip()!r}, {probability:.0%} sure)",
+                    + f" ({reason})",
             source_line=written or state.clause.text)
 
     def _prepare_repair(self, states: list[_ClauseState], diagnostics: tuple[Diagnostic, ...],

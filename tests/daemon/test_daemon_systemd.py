@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import shlex
 import shutil
 import signal
@@ -148,3 +149,19 @@ def test_socket_activation_serves_on_the_inherited_socket(workdir: Path) -> None
             process.kill()
             process.wait()
         notify.close()
+
+
+def test_the_units_exposure_stays_low() -> None:
+    """`systemd-analyze security` rates the unit; every remaining exposure is explained in its comments."""
+    analyzer = shutil.which("systemd-analyze")
+    if analyzer is None:
+        pytest.skip("systemd-analyze is not installed (apt-get install systemd); scripts/test.sh installs it")
+    result = subprocess.run(
+        [analyzer, "security", "--offline=true", "--no-pager", str(UNITS / "nrtrans.service")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    match = re.search(r"Overall exposure level for nrtrans\.service: (\d+\.\d+)", result.stdout)
+    assert match, result.stdout + result.stderr
+    assert float(match.group(1)) <= 1.2, result.stdout

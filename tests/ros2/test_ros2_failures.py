@@ -186,7 +186,7 @@ def test_a_goal_the_robot_settles_short_of_fails_without_waiting_for_the_timeout
     assert took < 8.0, f"took {took:.1f} s: it waited for the timeout"
 
 
-def test_a_profile_skill_the_backend_lacks_fails_as_a_step(bridge: Bridge, probe: Probe,
+def test_a_profile_skill_without_a_binding_fails_as_a_step(bridge: Bridge, probe: Probe,
                                                             profile: Profile) -> None:
     from rsl.profile import parse_profile
 
@@ -197,7 +197,7 @@ def test_a_profile_skill_the_backend_lacks_fails_as_a_step(bridge: Bridge, probe
         outcome = robot.wave(cancel=CancelToken())  # type: ignore[attr-defined]
         assert not hasattr(robot, "dance")
     assert outcome.status is Status.FAILED
-    assert "no implementation of the skill `wave`" in outcome.reason
+    assert "cannot run `wave`: it declares no binding in profile default" in outcome.reason
 
 
 def test_cancelling_a_head_move_holds_the_head_where_it_is(robot: Ros2Robot) -> None:

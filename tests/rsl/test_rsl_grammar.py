@@ -23,6 +23,9 @@ def test_llama_cpp_accepts_the_grammar(profile):
     llama_cpp = pytest.importorskip("llama_cpp")
     for objects in (None, ["cup", "table"], []):
         assert llama_cpp.LlamaGrammar.from_string(to_gbnf(profile, objects), verbose=False) is not None
+    narrowed = to_gbnf(profile, ["cup"], keywords=["grasp", "goto", "turnleft"], max_statements=3, refusal=True,
+                       numbers={"goto#0": ["-2", "1.5"], "rad": ["1.5708"]})
+    assert llama_cpp.LlamaGrammar.from_string(narrowed, verbose=False) is not None
 
 
 def test_thousands_of_programs_drawn_from_the_grammar_all_parse(profile, grammar):

@@ -163,14 +163,24 @@ def test_the_executor_watchdog_stops_a_step_slower_than_its_budget(profile: Prof
     assert budget + 1.5 < took < budget + 4.0  # the 2 s grace, then braking
 
 
-def test_a_skill_the_backend_lacks_fails_clearly(robot: SimRobot) -> None:
+def test_a_skill_without_a_binding_fails_clearly(robot: SimRobot) -> None:
     wave = '\n[[skills]]\nkeyword = "wave"\ndescription = "Wave."\nexample = "wave;"\nparams = []\n'
     extra = default_profile_path().read_text(encoding="utf-8") + wave
     waving = parse_profile(extra)
     result = execute(plan_of("forward 0.1; wave; forward 0.1;", waving), robot, waving)
     assert result.status is Status.FAILED
     assert [o.status for o in result.outcomes] == [Status.DONE, Status.FAILED]
-    assert "has no skill `wave`" in result.outcomes[1].reason
+    assert "the skill `wave` declares no binding" in result.outcomes[1].reason
+
+
+def test_a_skill_bound_to_ros_runs_in_the_simulator_as_not_simulated(robot: SimRobot) -> None:
+    dock = ('\n[[skills]]\nkeyword = "dock"\ndescription = "Dock."\nexample = "dock;"\nparams = []\n'
+            'binding = { ros = "trigger", service = "/dock" }\n')
+    docking = parse_profile(default_profile_path().read_text(encoding="utf-8") + dock)
+    result = execute(plan_of("forward 0.1; dock; forward 0.1;", docking), robot, docking)
+    assert result.ok, result
+    assert result.outcomes[1].reason.startswith("not simulated: `dock` calls the std_srvs/srv/Trigger service /dock")
+    assert robot.state().pose.x == pytest.approx(0.2, abs=0.005)  # the steps after it ran too
 
 
 def test_a_cancel_before_the_plan_starts_runs_nothing(robot: SimRobot, profile: Profile) -> None:

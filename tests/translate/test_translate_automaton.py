@@ -8,7 +8,6 @@ from hypothesis import strategies as st
 from agent.translate.automaton import START, RslAutomaton
 from agent.translate.clauses import split_clauses
 from rsl.compiler import compile_program
-from rsl.grammar import to_gbnf
 from rsl.profile import Profile
 
 
@@ -53,14 +52,6 @@ def test_narrowing_limits_objects_and_numbers(profile: Profile) -> None:
 def test_empty_object_list_drops_object_skills(profile: Profile) -> None:
     automaton = RslAutomaton(profile, objects=[])
     assert "grasp" not in automaton.skills and "forward" in automaton.skills
-
-
-def test_gbnf_export_matches_rsl_grammar_when_not_narrowed(profile: Profile) -> None:
-    # The statement alternatives must be the same set of skills as the official export.
-    ours = RslAutomaton(profile).to_gbnf()
-    theirs = to_gbnf(profile)
-    for keyword in profile.keywords:
-        assert f'"{keyword}' in ours and f'"{keyword}' in theirs
 
 
 def test_clauses_split_on_actions_not_on_coordinates(profile: Profile) -> None:

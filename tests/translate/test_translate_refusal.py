@@ -1,0 +1,89 @@
+"""The `// no program` line: the grammar offers it only when asked, and writing it refuses the clause."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+
+from agent.translate import Translator
+from agent.translate.automaton import END, START, RslAutomaton
+from agent.translate.engine import Generation, TokenMasks
+from rsl.diagnostics import Code
+from rsl.grammar import to_gbnf
+from rsl.profile import Profile
+from rsl.syntax import NO_PROGRAM
+from tests.rsl import gbnf
+
+REFUSAL = NO_PROGRAM + "\n\n"
+
+
+def test_refusal_line_is_offered_only_when_asked(profile: Profile) -> None:
+    with_refusal = RslAutomaton(profile, refusal=True)
+    assert with_refusal.accepts(REFUSAL)
+    assert with_refusal.accepts("forward 2;\n\n")
+    for bad in [NO_PROGRAM + "\n", NO_PROGRAM + "\nforward 2;\n\n", "forward 2;\n" + REFUSAL, "// no\n\n"]:
+        assert not with_refusal.accepts(bad), bad
+    assert not RslAutomaton(profile).accepts(REFUSAL)
+
+
+def test_every_gbnf_writer_offers_the_refusal_line_only_when_asked(profile: Profile) -> None:
+    for with_refusal, without in [(to_gbnf(profile, refusal=True), to_gbnf(profile)),
+                                  (RslAutomaton(profile, refusal=True).to_gbnf(), RslAutomaton(profile).to_gbnf())]:
+        assert gbnf.parse(with_refusal).regex().fullmatch(REFUSAL)
+        assert gbnf.parse(with_refusal).regex().fullmatch("forward 2;\n\n")
+        assert not gbnf.parse(with_refusal).regex().fullmatch(NO_PROGRAM + "\nforward 2;\n\n")
+        assert not gbnf.parse(without).regex().fullmatch(REFUSAL)
+
+
+def test_the_real_vocabulary_can_spell_the_refusal_token_by_token(translator: Translator, profile: Profile) -> None:
+    """Every token of the model's own spelling of the line is in the mask at its step."""
+    automaton = RslAutomaton(profile, refusal=True)
+    masks = TokenMasks(automaton, translator.engine.vocabulary)  # type: ignore[attr-defined]
+    llm = translator.engine.llm  # type: ignore[attr-defined]
+    state = START
+    for token in llm.tokenize(REFUSAL.encode(), add_bos=False, special=False):
+        ids, states = masks.at(state)
+        assert token in ids.tolist(), (state, llm.detokenize([token]))
+        state = states[ids.tolist().index(token)]
+    assert state == END
+    plain = TokenMasks(RslAutomaton(profile), translator.engine.vocabulary)  # type: ignore[attr-defined]
+    assert llm.tokenize(b"//", add_bos=False, special=False)[0] not in plain.at(START)[0].tolist()
+
+
+class _PrimedEngine:
+    """The real engine, with a prompt that shows the model writing the refusal line for small talk."""
+
+    chat_template = ""
+
+    def __init__(self, engine: object) -> None:
+        self.engine = engine
+        self.prompts: list[str] = []
+
+    def generate(self, prompt: str, automaton: RslAutomaton | None, max_tokens: int) -> Generation:
+        self.prompts.append(prompt)
+        shots = "".join(f"Task: {t}\nRSL:\n{REFUSAL}" for t in ("tell me a joke", "hello there", "how are you"))
+        return self.engine.generate(shots + "Task: what time is it\nRSL:\n", automaton, max_tokens)  # type: ignore[attr-defined]
+
+    def close(self) -> None:
+        """The wrapped engine belongs to the session fixture."""
+
+
+@pytest.mark.parametrize("grammar", [True, False])
+def test_writing_the_refusal_line_refuses_the_task_without_repair(translator: Translator, grammar: bool) -> None:
+    engine = _PrimedEngine(translator.engine)
+    options = dataclasses.replace(translator.options, refusal=True, grammar=grammar, split_clauses=False)
+    refusing = Translator(translator.profile, engine, translator.model_name, options)  # type: ignore[arg-type]
+    result = refusing.translate("what time is it")
+    assert result.attempts[0].program == NO_PROGRAM + "\n"
+    assert not result.verified and result.plan is None and result.passes == len(engine.prompts) == 1
+    assert [d.code for d in result.attempts[0].diagnostics] == [Code.NOT_A_TASK]
+    assert "no program" in result.attempts[0].diagnostics[0].message
+
+
+def test_without_the_option_the_grammar_forces_a_program(translator: Translator) -> None:
+    engine = _PrimedEngine(translator.engine)
+    options = dataclasses.replace(translator.options, split_clauses=False)
+    plain = Translator(translator.profile, engine, translator.model_name, options)  # type: ignore[arg-type]
+    result = plain.translate("what time is it")
+    assert NO_PROGRAM not in result.program
