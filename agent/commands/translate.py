@@ -120,10 +120,12 @@ def _translate(args: argparse.Namespace) -> int:
         print(_explained(result), file=sys.stderr)
     elif result.refused:
         from agent.translate.explain import capabilities
+        from rsl.diagnostics import Code
 
+        why = next(d.message for d in result.attempts[-1].diagnostics if d.code is Code.NOT_A_TASK)
         print(f"nrtrans translate: {args.task.strip()!r} was not understood as a task for this robot, so there "
-              f"is no program.\n  = help: say what the robot should do. It can: {capabilities(translator.profile)}.",
-              file=sys.stderr)
+              f"is no program.\n  = note: {why}\n  = help: say what the robot should do. It can: "
+              f"{capabilities(translator.profile)}.", file=sys.stderr)
     else:
         print(f"nrtrans translate: could not verify a program in {result.passes} pass(es); "
               "the last attempt was:", file=sys.stderr)
