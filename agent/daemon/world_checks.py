@@ -5,7 +5,7 @@
   other name is refused before motion, as `run-program` refuses it (E104).
 - A skill whose object is out of the arm's reach gets the skill the profile
   names for it (`out_of_reach = "approach"` on `grasp`) run first.
-- A straight drive through a known object is refused with where it would hit.
+- A straight drive through an object the robot has seen is refused with where it would hit.
 
 The base is followed from its current pose only through statements bound to
 the `drive` and `turn` primitives (their sign says which way) or that do not move the base;
@@ -45,32 +45,35 @@ class WorldCheck:
     added: tuple[str, ...] = ()  # statements added, e.g. "approach cup;"
 
 
-def known_things(robot: Any) -> tuple[list[Thing], bool]:
-    """What the robot knows is around it, and whether that is the whole world (a simulator's scene).
+def known_things(robot: Any) -> tuple[list[Thing], list[Thing], bool]:
+    """What the robot can name, what it has seen, and whether the names are the whole world (a scene).
 
-    Only a scene is the whole world: a real robot may find more by looking, so unknown names are left to it.
+    Only a simulator's scene is the whole world: a real robot may find more by looking, so unknown names
+    are left to it. Only what the robot has seen is an obstacle: it cannot plan around what it never saw.
     """
-    things: dict[str, Thing] = {}
+    named: dict[str, Thing] = {}
     scene = getattr(getattr(robot, "world", None), "scene", None)
     objects = getattr(scene, "objects", None)
     for obj in objects or ():
         half_x, half_y = obj.size[0] / 2, obj.size[1] / 2
         if obj.yaw:
             half_x = half_y = math.hypot(half_x, half_y)
-        things[obj.name] = Thing(obj.name, obj.x, obj.y, half_x, half_y)
+        named[obj.name] = Thing(obj.name, obj.x, obj.y, half_x, half_y)
     try:
         state = robot.state()
     except Exception:
-        return list(things.values()), objects is not None
+        return list(named.values()), [], objects is not None
+    seen = []
     for name, x, y in state.known_objects:
-        seen = things.get(name)
-        things[name] = Thing(name, x, y, seen.half_x if seen else _UNKNOWN_RADIUS,
-                             seen.half_y if seen else _UNKNOWN_RADIUS)
-    return list(things.values()), objects is not None
+        size = named.get(name)
+        named[name] = Thing(name, x, y, size.half_x if size else _UNKNOWN_RADIUS,
+                            size.half_y if size else _UNKNOWN_RADIUS)
+        seen.append(named[name])
+    return list(named.values()), seen, objects is not None
 
 
 def check_world(plan: Plan, profile: Profile, robot: Any) -> WorldCheck:
-    things, whole_world = known_things(robot)
+    things, seen, whole_world = known_things(robot)
     if not things:
         return WorldCheck(plan)
     by_name = {t.name: t for t in things}
@@ -108,7 +111,7 @@ def check_world(plan: Plan, profile: Profile, robot: Any) -> WorldCheck:
             bearing = heading + (0.0 if primitive.sign > 0 else math.pi)
             distance = command.args[0].value
             hit = _first_hit(x, y, bearing, distance, profile.motion.width / 2,
-                             (t for t in things if t.name != holding))
+                             (t for t in seen if t.name != holding))
             if hit is not None:
                 thing, at = hit
                 return WorldCheck(None, f"`{command.to_rsl()}` (line {command.line}) would drive into the "

@@ -50,6 +50,8 @@ def test_an_object_the_robot_does_not_know_is_refused_before_motion(service: Ser
 
 
 def test_a_drive_through_a_known_obstacle_is_refused_before_motion(service: Service) -> None:
+    looked, _ = _run(service, "perceive;")
+    assert looked.state is TaskState.DONE and "table" in {n for n, _x, _y in service.robot.state().known_objects}
     before = service.robot.state().pose
     task, seen = _run(service, "forward 4;")
     assert task.state is TaskState.REJECTED, task.reason
