@@ -87,8 +87,8 @@ KOREAN = Lexicon(
     wake_words=("로봇",),
     stop_words=("멈춰", "정지", "그만", "스톱", "중지"),
     stop_fillers=("지금", "당장", "제발", "다", "모두"),
-    yes_words=("네", "예", "응", "그래", "좋아", "맞아"),
-    no_words=("아니", "아니요", "아니오", "안돼", "하지마"),
+    yes_words=("네", "예"),
+    no_words=("아니", "아니요"),
 )
 
 LEXICONS: dict[str, Lexicon] = {lexicon.language: lexicon for lexicon in (ENGLISH, KOREAN)}
