@@ -144,6 +144,10 @@ class Client:
     def cancel(self, task: str) -> dict[str, Any]:
         return self.request("cancel", task=task)
 
+    def confirm(self, task: str, accept: bool) -> dict[str, Any]:
+        """Answer a `confirm` question: let the plan run, or cancel it."""
+        return self.request("confirm", task=task, accept=accept)
+
     def estop(self, reason: str | None = None) -> dict[str, Any]:
         return self.request("estop", **({"reason": reason} if reason else {}))
 
@@ -226,6 +230,15 @@ def describe_event(event: dict[str, Any]) -> str:
         detail = f"{event['pass']}: {event['program'].strip()!r} ({verdict})"
     elif name == "verified":
         detail = event["program"].strip().replace("\n", " ")
+        if event.get("explanation"):
+            detail += f" -> {event['explanation']}"
+    elif name == "confirm":
+        sure = "" if event.get("confidence") is None else f" (confidence {event['confidence']:.2f})"
+        detail = f"should I {event['explanation']}?{sure}"
+        if event.get("reasons"):
+            detail += " Unsure because " + "; ".join(event["reasons"])
+    elif name == "answered":
+        detail = f"{'accepted' if event['accepted'] else 'declined'} by {event['by']}"
     elif name == "executing":
         detail = f"step {event['step']}/{event['total']}: {event['statement']}"
     elif name == "step":

@@ -126,6 +126,10 @@ class Skill:
     # What the skill does on a robot; None only in profiles that never reach one
     # (the backends refuse such a skill with the reason).
     binding: Binding | None = None
+    # How explain-back says one statement, e.g. "drive forward {distance}"; empty: worded from `description`.
+    say: str = ""
+    # A skill run first on this skill's object when the object is out of the arm's reach (`approach`).
+    out_of_reach: str | None = None
 
     @property
     def primitive(self) -> Primitive | None:
@@ -181,6 +185,7 @@ class Motion:
     reach: float = 0.8
     standoff: float = 0.5
     timeout_margin: float = 5.0
+    width: float = 0.4  # m, across the base: the corridor a straight drive sweeps
 
 
 @dataclass(frozen=True)
@@ -279,6 +284,8 @@ def _build(data: dict[str, Any], source: str) -> Profile:
     for skill in skills:
         if skill.opposite is not None and skill.opposite not in seen:
             raise fail(f"skill `{skill.keyword}`: opposite `{skill.opposite}` is not a skill")
+        if skill.out_of_reach is not None and skill.out_of_reach not in seen:
+            raise fail(f"skill `{skill.keyword}`: out_of_reach `{skill.out_of_reach}` is not a skill")
         for alias in skill.aliases:
             if alias in seen:
                 raise fail(f"alias `{alias}` of `{skill.keyword}` is itself a skill keyword")
@@ -386,7 +393,8 @@ def _skill(raw: dict[str, Any], index: int, workspace: dict[str, tuple[float, fl
         binding = _binding(raw["binding"], word, tuple(params), lambda m: fail(f"skill `{word}`: binding {m}"))
     return Skill(keyword=word, description=str(raw.get("description", "")),
                  example=str(raw.get("example", f"{word};")), params=tuple(params), aliases=aliases,
-                 opposite=raw.get("opposite"), binding=binding)
+                 opposite=raw.get("opposite"), binding=binding,
+                 say=str(raw.get("say", "")), out_of_reach=raw.get("out_of_reach"))
 
 
 def _binding(raw: Any, word: str, params: tuple[Param, ...], fail: Any) -> Binding:

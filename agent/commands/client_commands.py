@@ -58,6 +58,15 @@ def register(subparsers: Any) -> None:
     )
     status.add_argument("task", nargs="?", metavar="ID", help="a task id from `nrtrans send` or `history`")
 
+    confirm = add(
+        "confirm",
+        "answer the daemon's question about a task",
+        "Let a task the daemon asked about (a `confirm` event) run, or cancel it. "
+        "The audit log records your uid as the one who answered.",
+        _confirm,
+    )
+    confirm.add_argument("task", metavar="ID")
+    confirm.add_argument("answer", choices=("yes", "no"))
     cancel = add("cancel", "cancel one task", "Cancel a queued or running task; a running one stops mid-step.", _cancel)
     cancel.add_argument("task", metavar="ID")
 
@@ -136,11 +145,37 @@ def _send(args: argparse.Namespace) -> int:
                 _print_event(event, args.json)
                 if event["event"] == "done":
                     return EXIT_DONE
+                if event["event"] == "confirm":
+                    _answer(client, task, event["timeout_s"])
         except KeyboardInterrupt:
             client.cancel(task)
             print(f"nrtrans send: cancelled task {task}", file=sys.stderr)
             return 130
         return EXIT_NOT_DONE
+
+    return _call(args, action)
+
+
+def _answer(client: Any, task: str, timeout_s: float) -> None:
+    """Put the daemon's question to the person at a terminal; elsewhere say how to answer it."""
+    if not sys.stdin.isatty():
+        print(f"nrtrans send: the daemon asks before moving; answer within {timeout_s:g} s with "
+              f"`nrtrans confirm {task} yes` (or `no`)", file=sys.stderr)
+        return
+    from agent.client import RequestFailed
+
+    reply = input(f"Run it? [y/N] (within {timeout_s:g} s) ").strip().lower()
+    try:
+        client.confirm(task, reply in ("y", "yes"))
+    except RequestFailed as exc:
+        print(f"nrtrans send: {exc.message}", file=sys.stderr)
+
+
+def _confirm(args: argparse.Namespace) -> int:
+    def action(client: Any) -> int:
+        client.confirm(args.task, args.answer == "yes")
+        print(f"{args.task}: {'accepted' if args.answer == 'yes' else 'declined'}")
+        return 0
 
     return _call(args, action)
 

@@ -64,7 +64,8 @@ def register(subparsers: Any) -> None:
     parser.add_argument("task", help="the task, in quotes")
     parser.add_argument("--json", action="store_true",
                         help="print one JSON object: task, program, verified, passes, attempts, plan, "
-                             "model, timings_ms")
+                             "model, timings_ms, explanation, confidence, doubts, confirm (true when the "
+                             "default confirm policy would ask before running it), refused")
     parser.add_argument("--objects", metavar="A,B",
                         help="objects the robot knows; other object names are errors to repair")
     parser.add_argument("-v", "--verbose", action="store_true",
@@ -116,6 +117,15 @@ def _translate(args: argparse.Namespace) -> int:
         print(json.dumps(result.to_json_dict(), indent=2))
     elif result.verified:
         print(result.program, end="")
+        print(_explained(result), file=sys.stderr)
+    elif result.refused:
+        from agent.translate.explain import capabilities
+        from rsl.diagnostics import Code
+
+        why = next(d.message for d in result.attempts[-1].diagnostics if d.code is Code.NOT_A_TASK)
+        print(f"nrtrans translate: {args.task.strip()!r} was not understood as a task for this robot, so there "
+              f"is no program.\n  = note: {why}\n  = help: say what the robot should do. It can: "
+              f"{capabilities(translator.profile)}.", file=sys.stderr)
     else:
         print(f"nrtrans translate: could not verify a program in {result.passes} pass(es); "
               "the last attempt was:", file=sys.stderr)
@@ -123,6 +133,16 @@ def _translate(args: argparse.Namespace) -> int:
         for diagnostic in result.attempts[-1].diagnostics if result.attempts else ():
             print(diagnostic.render(), file=sys.stderr, end="")
     return EXIT_VERIFIED if result.verified else EXIT_UNVERIFIED
+
+
+def _explained(result: Any) -> str:
+    """The plan in words and how sure the translation is, with why when it would ask first."""
+    text = f"-> {result.explanation}"
+    if result.confidence is not None:
+        text += f"\n   confidence {result.confidence:.2f}"
+        if result.confirm:
+            text += "; nrtrans serve would ask before running it: " + "; ".join(result.doubts)
+    return text
 
 
 def _show_progress() -> None:

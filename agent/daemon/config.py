@@ -131,6 +131,20 @@ class TranslatorConfig:
         default=3,
         metadata=_doc("Most translation attempts per task (the first plus repairs from compiler diagnostics).", min=1),
     )
+    confirm: str = field(
+        default="unsure",
+        metadata=_doc(
+            "When to ask the person before a verified plan moves the robot: `unsure` when the "
+            "translation's confidence is low or its meaning checks disagree with the task, `always`, "
+            "or `never`. The question is a `confirm` event; a `confirm` request or a spoken yes/no "
+            "answers it. Applies at once on SIGHUP.",
+            choices=("never", "unsure", "always"),
+        ),
+    )
+    confirm_timeout: float = field(
+        default=20.0,
+        metadata=_doc("Seconds to wait for an answer; with none the task is cancelled and nothing moves.", min=0.1),
+    )
 
 
 @dataclass(frozen=True)

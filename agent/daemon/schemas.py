@@ -56,6 +56,13 @@ REQUESTS: dict[str, dict[str, Any]] = {
     "cancel": _request(
         "cancel", "Cancel one task: dropped if queued, stopped mid-step if running.", {"task": _TASK_ID}, ("task",)
     ),
+    "confirm": _request(
+        "confirm",
+        "Answer the question a `confirm` event asked about a task: `accept` true lets its plan run, "
+        "false cancels it and nothing moves. The audit log records who answered.",
+        {"task": _TASK_ID, "accept": {"type": "boolean"}},
+        ("task", "accept"),
+    ),
     "estop": _request(
         "estop",
         "Emergency stop: stop the robot now, cancel every task and refuse new ones until `reset`.",
@@ -74,7 +81,9 @@ REQUESTS: dict[str, dict[str, Any]] = {
     ),
 }
 
-_TASK_STATES = ["queued", "translating", "executing", "done", "failed", "rejected", "cancelled", "interrupted"]
+_TASK_STATES = [
+    "queued", "translating", "confirming", "executing", "done", "failed", "rejected", "cancelled", "interrupted"
+]
 
 TASK_RECORD: dict[str, Any] = {
     "type": "object",
@@ -112,6 +121,7 @@ REPLY: dict[str, Any] = {
         "position": {"type": "integer", "minimum": 0},
         "daemon": {"type": "object"},
         "latched": {"type": "boolean"},
+        "accepted": {"type": "boolean"},
         "subscribed": {"type": "boolean"},
         "listening": {"type": "boolean"},
         "healthy": {"type": "boolean"},
@@ -131,6 +141,7 @@ ERROR_CODES = {
     "busy": "The task queue or the client table is full; try again when a task has finished.",
     "estopped": "An emergency stop is latched; send `reset` first.",
     "not_found": "No task with that id is known.",
+    "not_waiting": "The task is not waiting for a confirmation (it was answered, timed out or never asked).",
     "forbidden": "This caller's uid/gid is not on the allow-list.",
     "unavailable": "The part the request needs (e.g. speech input) is not running; see `health`.",
     "too_slow": "This client fell too far behind reading its frames and is being disconnected.",
@@ -199,8 +210,30 @@ EVENT_FIELDS: dict[str, tuple[str, dict[str, Any]]] = {
         },
     ),
     "verified": (
-        "The program compiled; this plan will run.",
-        {"program": {"type": "string"}, "plan": {"type": "array"}},
+        "The program compiled; this plan will run (after a `confirm` question, when the policy asks one). "
+        "`explanation` says the plan in words; `confidence` (0 to 1, null for a submitted `rsl` "
+        "program) is how sure the translation is that the plan is what was meant.",
+        {
+            "program": {"type": "string"},
+            "plan": {"type": "array"},
+            "explanation": {"type": "string"},
+            "confidence": {"type": ["number", "null"], "minimum": 0, "maximum": 1},
+        },
+    ),
+    "confirm": (
+        "The daemon asks before the robot moves (config `translator.confirm`). Nothing moves until a "
+        "`confirm` request or a spoken yes/no answers; after `timeout_s` the task is cancelled.",
+        {
+            "text": {"type": ["string", "null"]},
+            "explanation": {"type": "string"},
+            "confidence": {"type": ["number", "null"], "minimum": 0, "maximum": 1},
+            "reasons": {"type": "array", "items": {"type": "string"}},
+            "timeout_s": {"type": "number"},
+        },
+    ),
+    "answered": (
+        "The `confirm` question was answered; `by` is `uid N` for a request or `voice`.",
+        {"accepted": {"type": "boolean"}, "by": {"type": "string"}},
     ),
     "rejected": (
         "No verified program; nothing moved.",

@@ -288,6 +288,9 @@ class SocketServer:
         if request.op == "cancel":
             task = service.cancel(body["task"])
             return reply_frame(request, task=task.id, state=task.state.value)
+        if request.op == "confirm":
+            task = service.confirm(body["task"], bool(body["accept"]), f"uid {client.peer.uid}")
+            return reply_frame(request, task=task.id, accepted=bool(body["accept"]))
         if request.op == "estop":
             self._estop(client.peer, body)
             return reply_frame(request, latched=True)

@@ -8,6 +8,7 @@ of a task goes to the audit log (fsync'd) before it is announced.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import os
 import threading
@@ -19,12 +20,20 @@ from typing import Any
 
 from agent.daemon.audit import AuditError, AuditLog
 from agent.daemon.config import Config
+from agent.daemon.confirm import Question
 from agent.daemon.events import EventBus
 from agent.daemon.health import describe
 from agent.daemon.protocol import ProtocolError
 from agent.daemon.tasks import Busy, Peer, Task, TaskQueue, TaskState
+from agent.daemon.world_checks import check_world
+from agent.translate.confidence import UNSURE_BELOW
+from agent.translate.explain import capabilities, explain
 
 log = logging.getLogger(__name__)
+
+
+# The longest the robot waits for its plan to be said before it moves (only with spoken feedback on).
+_EXPLAIN_WAIT_S = 8.0
 
 
 class StartupError(RuntimeError):
@@ -53,6 +62,7 @@ class Service:
         self._worker_error: str | None = None
         self.warm_s: float | None = None
         self._execute_plan: Callable[..., Any] | None = None
+        self._questions: dict[str, Question] = {}
 
     # -- start and stop -------------------------------------------------------------------------
 
@@ -121,7 +131,7 @@ class Service:
             for name, old, changed in (
                 ("state_dir", self.config.state_path(), new.state_path()),
                 ("api.socket", self.config.socket_path(), new.socket_path()),
-                ("translator", self.config.translator, new.translator),
+                ("translator", _needs_restart(self.config.translator), _needs_restart(new.translator)),
                 ("robot", self.config.robot, new.robot),
                 ("speech", self.config.speech, new.speech),
                 ("audit.file", self.config.audit.file, new.audit.file),
@@ -352,10 +362,17 @@ class Service:
         plan = self._translate(task, known, start) if task.text is not None else self._compile(task, known, start)
         if plan is None:
             return
+        world = check_world(plan, self.profile, self.robot)
+        if world.plan is None:
+            self._reject(task, world.refusal, [])
+            return
+        plan = world.plan
         task.program = plan.to_rsl()
         task.plan = plan.to_list()
-        self.events.publish("verified", task.id, program=task.program, plan=task.plan)
-        if self._halted(task):
+        task.explanation = explain(plan, self.profile)
+        self.events.publish("verified", task.id, program=task.program, plan=task.plan,
+                            explanation=task.explanation, confidence=task.confidence)
+        if self._halted(task) or not self._confirmed(task):
             return
         task.state = TaskState.EXECUTING
         # The plan is on disk before the first command reaches the robot.
@@ -402,8 +419,14 @@ class Service:
             return None
         if not result.verified or result.plan is None:
             last = task.attempts[-1]["diagnostics"] if task.attempts else []
-            self._reject(task, f"no verified program after {result.passes} attempt(s); nothing moved", last)
+            if getattr(result, "refused", False):
+                self._reject(task, "not understood as a task for this robot; nothing moved. It can: "
+                             + capabilities(self.profile), last)
+            else:
+                self._reject(task, f"no verified program after {result.passes} attempt(s); nothing moved", last)
             return None
+        task.confidence = getattr(result, "confidence", None)
+        task.doubts = list(getattr(result, "doubts", ()))
         return result.plan
 
     def _compile(self, task: Task, known: list[str] | None, start: float) -> Any:
@@ -473,6 +496,53 @@ class Service:
             self._finish(task, TaskState.CANCELLED, task.cancel.reason or _last_reason(result), robot_state=final_state)
         else:
             self._finish(task, TaskState.FAILED, _last_reason(result) or "a step failed", robot_state=final_state)
+
+    def confirm(self, task_id: str, accept: bool, by: str) -> Task:
+        """Answer the open question about `task_id`; raises `not_waiting` when none is open."""
+        task = self.task(task_id)
+        with self._lock:
+            question = self._questions.get(task_id)
+        if question is None or not question.answer(accept, by):
+            raise ProtocolError(
+                "not_waiting",
+                f"task {task_id} is not waiting for a confirmation (it is {task.state.value})",
+                "answer only after a `confirm` event, within its timeout_s",
+            )
+        return task
+
+    def _confirmed(self, task: Task) -> bool:
+        """Whether the plan may run: asks the person first when the confirm policy says so."""
+        policy = self.config.translator.confirm
+        unsure = task.text is not None and (task.confidence is None or task.confidence < UNSURE_BELOW)
+        if policy == "never" or (policy == "unsure" and not unsure):
+            self._say(task.explanation, wait_s=_EXPLAIN_WAIT_S)
+            return True
+        question = Question(task.id)
+        timeout = self.config.translator.confirm_timeout
+        with self._lock:
+            self._questions[task.id] = question
+        try:
+            task.state = TaskState.CONFIRMING
+            self.audit.write(task.record())
+            self.events.publish("confirm", task.id, text=task.text, explanation=task.explanation,
+                                confidence=task.confidence, reasons=task.doubts, timeout_s=timeout)
+            self._say(f"Should I {task.explanation}? Say yes or no.")
+            answer = question.wait(timeout, task.cancel)
+        finally:
+            with self._lock:
+                self._questions.pop(task.id, None)
+        if answer.by:
+            self.events.publish("answered", task.id, accepted=answer.accepted, by=answer.by)
+        if not answer.accepted:
+            self._finish(task, TaskState.CANCELLED, answer.reason)
+            return False
+        task.confirmed_by = answer.by
+        return True
+
+    def _say(self, text: str, *, wait_s: float = 0.0) -> None:
+        """Spoken feedback, when speech is on and its feedback is enabled; never fails the task."""
+        if self.speech is not None:
+            _quietly(lambda: self.speech.say(text, wait_s=wait_s))
 
     # -- helpers ---------------------------------------------------------------------------
 
@@ -567,7 +637,7 @@ class Service:
         text = str(transcript.text).strip()
         if not text:
             return
-        from agent.speech.lexicon import is_stop_command
+        from agent.speech.lexicon import is_stop_command, yes_or_no
 
         if is_stop_command(text):
             cancelled = self.halt(f"stopped by voice: {text!r}")
@@ -575,7 +645,14 @@ class Service:
             self.events.publish("speech", None, state="stop", detail={"text": text, "cancelled": cancelled})
             return
         if getattr(transcript, "source", None) == "barge_in":
-            return  # the stop listener only ever stops; nothing it hears becomes a task
+            return  # the stop listener only ever stops; nothing it hears becomes a task or an answer
+        reply = yes_or_no(text)
+        with self._lock:
+            open_questions = list(self._questions)
+        if reply is not None and open_questions:
+            self.confirm(open_questions[0], reply, "voice")
+            log.info("heard %r: task %s %s", text, open_questions[0], "accepted" if reply else "declined")
+            return
         heard = transcript.to_dict() if hasattr(transcript, "to_dict") else {"text": text}
 
         def announce(task: Task) -> None:
@@ -591,6 +668,11 @@ class Service:
     def _on_speech_event(self, event: Any) -> None:
         detail = event.to_dict() if hasattr(event, "to_dict") else {}
         self.events.publish("speech", None, state=str(getattr(event, "kind", event)), detail=detail)
+
+
+def _needs_restart(translator: Any) -> Any:
+    """The translator settings that take a restart: all but the confirm policy, which applies at once."""
+    return dataclasses.replace(translator, confirm="", confirm_timeout=0.0)
 
 
 def _last_reason(result: Any) -> str:

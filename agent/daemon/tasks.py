@@ -21,6 +21,7 @@ from agent.robot import CancelToken
 class TaskState(Enum):
     QUEUED = "queued"
     TRANSLATING = "translating"
+    CONFIRMING = "confirming"  # verified, waiting for the person to answer the `confirm` question
     EXECUTING = "executing"
     DONE = "done"
     FAILED = "failed"
@@ -66,6 +67,10 @@ class Task:
     steps: list[dict[str, Any]] = field(default_factory=list)
     reason: str = ""
     model: str | None = None
+    explanation: str = ""
+    confidence: float | None = None
+    confirmed_by: str | None = None  # who let an asked plan run: "uid N" or "voice"
+    doubts: list[str] = field(default_factory=list)  # why the translation is unsure
     timings_ms: dict[str, float] = field(default_factory=dict)
     cancel: CancelToken = field(default_factory=CancelToken, repr=False)
 
@@ -86,6 +91,10 @@ class Task:
             "steps": list(self.steps),
             "reason": self.reason,
             "model": self.model,
+            "explanation": self.explanation,
+            "confidence": self.confidence,
+            "confirmed_by": self.confirmed_by,
+            "doubts": list(self.doubts),
             "timings_ms": dict(self.timings_ms),
         }
 

@@ -6,6 +6,7 @@ feedback is switched off once, with the reason logged.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
 import shutil
@@ -31,8 +32,11 @@ class Speaker:
         self._lock = threading.Lock()
         self._current: subprocess.Popen[bytes] | None = None
 
-    def speak(self, text: str) -> bool:
-        """Start saying `text`, cutting off anything still being said; False when feedback is off."""
+    def speak(self, text: str, *, wait_s: float = 0.0) -> bool:
+        """Start saying `text`, cutting off anything still being said; False when feedback is off.
+
+        `wait_s` > 0 waits up to that long for it to be said: an explanation is heard before the robot moves.
+        """
         if not self.enabled:
             return False
         program = shutil.which("espeak-ng")
@@ -53,6 +57,10 @@ class Speaker:
                 self.reason = f"espeak-ng cannot run: {exc}"
                 log.warning("spoken feedback is off: %s", self.reason)
                 return False
+            speaking = self._current
+        if wait_s > 0:
+            with contextlib.suppress(subprocess.TimeoutExpired):
+                speaking.wait(wait_s)
         return True
 
     def close(self) -> None:

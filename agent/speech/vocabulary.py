@@ -44,7 +44,7 @@ def supports_runtime_grammar(model_path: str | Path) -> bool:
 def wanted_words(profile: Profile, lexicon: Lexicon, objects: Iterable[str] = (),
                  wake_words: Sequence[str] = ()) -> list[str]:
     """Every word worth biasing toward, before checking the model's lexicon."""
-    words: list[str] = [*wake_words, *lexicon.stop_words]
+    words: list[str] = [*wake_words, *lexicon.stop_words, *lexicon.yes_words, *lexicon.no_words]
     for skill in profile.skills:
         if lexicon.language == "en":
             for name in (skill.keyword, *skill.aliases):

@@ -49,6 +49,8 @@ class Generation:
     # vocabulary): a clause the model does not read as a robot task shows in these.
     first_piece: str = ""
     first_probability: float | None = None  # None: this engine cannot tell
+    # Each chosen token's probability among the tokens the grammar allowed there; empty: cannot tell.
+    token_probabilities: tuple[float, ...] = ()
 
 
 def use_plain_cpu_buffers() -> None:
@@ -278,6 +280,7 @@ class LocalEngine:
         finished = False
         pieces = self.vocabulary.pieces
         first_piece, first_probability = "", 0.0
+        chosen: list[float] = []
         while generated < max_tokens:
             check()
             logits = np.ctypeslib.as_array(llama_cpp.llama_get_logits_ith(llm._ctx.ctx, -1), shape=(n_vocab,))
@@ -295,7 +298,9 @@ class LocalEngine:
                 ids, states = masks.closing(state) if full else masks.at(state)
                 if len(ids) == 0:
                     break
-                choice = int(np.argmax(logits[ids]))
+                allowed = logits[ids]
+                choice = int(np.argmax(allowed))
+                chosen.append(float(1.0 / np.exp(allowed - allowed[choice]).sum()))
                 token, state = int(ids[choice]), states[choice]
             out += pieces[token]
             generated += 1
@@ -309,7 +314,8 @@ class LocalEngine:
         done = time.perf_counter()
         return Generation(text=text, prompt_tokens=len(tokens), reused_tokens=reused, generated_tokens=generated,
                           prompt_ms=(prompt_done - started) * 1000, generate_ms=(done - prompt_done) * 1000,
-                          finished=finished, first_piece=first_piece, first_probability=first_probability)
+                          finished=finished, first_piece=first_piece, first_probability=first_probability,
+                          token_probabilities=tuple(chosen))
 
     def close(self) -> None:
         close = getattr(self.llm, "close", None)

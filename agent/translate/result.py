@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-from rsl.diagnostics import Diagnostic
+from rsl.diagnostics import Code, Diagnostic
 from rsl.plan import Plan
 
 
@@ -36,6 +36,19 @@ class TranslationResult:
     plan: Plan | None
     model: str
     timings_ms: dict[str, float] = field(default_factory=dict)
+    # The plan in plain words ("drive forward 3 m, then turn right 90°"); empty without a plan.
+    explanation: str = ""
+    # How sure the translation is that the plan is what was meant; None without a plan.
+    confidence: float | None = None
+    # Why it is unsure, one reason a person can read per entry.
+    doubts: tuple[str, ...] = ()
+    # Whether the default policy (`confirm = "unsure"`) asks before the plan runs.
+    confirm: bool = False
+
+    @property
+    def refused(self) -> bool:
+        """Whether the task was not read as a task for the robot, rather than written wrongly."""
+        return bool(self.attempts) and any(d.code is Code.NOT_A_TASK for d in self.attempts[-1].diagnostics)
 
     def to_json_dict(self) -> dict[str, Any]:
         """The `nrtrans translate --json` contract; keep the keys stable."""
@@ -48,4 +61,9 @@ class TranslationResult:
             "plan": self.plan.to_list() if self.plan is not None else [],
             "model": self.model,
             "timings_ms": {k: round(v, 3) for k, v in self.timings_ms.items()},
+            "explanation": self.explanation,
+            "confidence": self.confidence,
+            "doubts": list(self.doubts),
+            "confirm": self.confirm,
+            "refused": self.refused,
         }

@@ -23,6 +23,7 @@ from agent.adapter.card import AdapterCard, card_path, read_card
 from agent.normalize import normalize_task
 from agent.translate.automaton import RslAutomaton
 from agent.translate.clauses import Clause, split_clauses
+from agent.translate.confidence import judge
 from agent.translate.engine import CancelFlag, Generation
 from agent.translate.model_path import ModelNotFoundError
 from agent.translate.prompt import (
@@ -108,6 +109,7 @@ class _ClauseState:
     refused: bool = False  # the model wrote NO_PROGRAM
     lines: tuple[int, int] = (0, 0)
     timings: dict[str, float] = field(default_factory=dict)
+    probabilities: tuple[float, ...] = ()  # the model's choices under the grammar, for the confidence
 
 
 class Translator:
@@ -204,6 +206,7 @@ class Translator:
                 timings["prompt"] += generation.prompt_ms
                 timings["generate"] += generation.generate_ms
                 state.program = _tidy(generation.text)
+                state.probabilities = generation.token_probabilities
                 state.refused = self.options.refusal and state.program == NO_PROGRAM + "\n"
                 progress.debug("pass %d, clause %r -> %r (prompt %.0f ms, generation %.0f ms)", len(attempts) + 1,
                                state.clause.text, state.program.strip(), generation.prompt_ms,
@@ -228,15 +231,20 @@ class Translator:
             if not pending:
                 break
         assert result is not None
-        timings["total"] = (time.perf_counter() - started) * 1000
         verified = attempts[-1].ok
+        plan = result.plan if verified else None
+        judged = {}
+        if plan is not None:
+            checks_started = time.perf_counter()
+            judged = judge(normalized, plan, self.profile, (p for s in states for p in s.probabilities), known)
+            timings["checks"] = (time.perf_counter() - checks_started) * 1000
+        timings["total"] = (time.perf_counter() - started) * 1000
         progress.debug("%s after %d pass(es) in %.0f ms: prompt %.0f ms, generation %.0f ms, compile %.1f ms",
                        "verified" if verified else "NOT verified", len(attempts), timings["total"],
                        timings["prompt"], timings["generate"], timings["compile"])
         return TranslationResult(task=task, program=attempts[-1].program, verified=verified,
                                  passes=len(attempts), attempts=tuple(attempts),
-                                 plan=result.plan if verified else None, model=self.model_name,
-                                 timings_ms=timings)
+                                 plan=plan, model=self.model_name, timings_ms=timings, **judged)
 
     def prompt_for(self, text: str, extra: str = "") -> str:
         """The prompt for one normalized clause; `extra` is repair feedback."""

@@ -16,7 +16,7 @@ RENAMED = {
 FETCH_AND_RETURN = "sense;\nclosein table;\nclutch cup;\ntravel 0, 0;\n"
 _WORD = re.compile(r"\b(" + "|".join(RENAMED) + r")\b")
 # Only the lines that name skills: descriptions and aliases keep their English words.
-_SKILL_LINE = re.compile(r'^(keyword|opposite|example|program) = ".*"$', re.M)
+_SKILL_LINE = re.compile(r'^(keyword|opposite|out_of_reach|example|program) = ".*"$', re.M)
 
 
 def renamed_profile_text() -> str:

@@ -22,9 +22,22 @@ def test_json_contract_and_exit_zero_when_verified(model_path: Path) -> None:
     done = _run("translate", "--json", "--model", str(model_path), "--objects", "cup", "grasp the cup")
     assert done.returncode == 0, done.stderr
     data = json.loads(done.stdout)
-    assert set(data) == {"task", "program", "verified", "passes", "attempts", "plan", "model", "timings_ms"}
+    assert set(data) == {"task", "program", "verified", "passes", "attempts", "plan", "model", "timings_ms",
+                         "explanation", "confidence", "doubts", "confirm", "refused"}
     assert data["verified"] is True and data["task"] == "grasp the cup"
     assert data["plan"] and all("skill" in c for c in data["plan"])
+    assert data["explanation"] == "pick up the cup" and 0 <= data["confidence"] <= 1
+    assert data["confirm"] is (data["confidence"] < 0.5) and data["refused"] is False
+    plain = _run("translate", "--model", str(model_path), "--objects", "cup", "grasp the cup")
+    assert plain.stdout == data["program"] and "-> pick up the cup" in plain.stderr
+
+
+def test_a_refused_non_task_says_it_was_not_understood_not_that_the_program_is_wrong() -> None:
+    done = _run("translate", "--adapter", "default", "what time is it")
+    assert done.returncode == 1 and done.stdout == ""
+    assert "was not understood as a task for this robot" in done.stderr
+    assert "It can: drive straight ahead" in done.stderr
+    assert "could not verify" not in done.stderr and "^" not in done.stderr
 
 
 def test_exit_one_and_last_attempt_shown_when_not_verified(model_path: Path) -> None:

@@ -13,7 +13,8 @@ from rsl.compiler import compile_program
 from rsl.diagnostics import Code
 from rsl.profile import Profile
 
-CONTRACT_KEYS = {"task", "program", "verified", "passes", "attempts", "plan", "model", "timings_ms"}
+CONTRACT_KEYS = {"task", "program", "verified", "passes", "attempts", "plan", "model", "timings_ms",
+                 "explanation", "confidence", "doubts", "confirm", "refused"}
 
 
 def _variant(translator: Translator, **changes: object) -> Translator:
@@ -26,7 +27,7 @@ def test_result_follows_the_json_contract(translator: Translator, profile: Profi
     result = translator.translate("move forward two meters, then grasp the cup", known_objects=["cup"])
     data = result.to_json_dict()
     assert set(data) == CONTRACT_KEYS
-    assert set(data["timings_ms"]) == {"prompt", "generate", "compile", "total"}
+    assert set(data["timings_ms"]) == {"prompt", "generate", "compile", "checks", "total"}
     assert data["passes"] == len(data["attempts"]) >= 1
     assert all(set(a) == {"program", "diagnostics"} for a in data["attempts"])
     assert data["program"] == data["attempts"][-1]["program"]

@@ -1,0 +1,335 @@
+"""Checks between what a person said and the plan that verified: does it do what was asked?
+
+A program can be grammatical and in range and still not be what was meant:
+a polite closing that drives 1 m, a request about the head that turns the
+base, 90 degrees said and 688 degrees planned. Each check here compares
+the normalized task with the plan and, when they disagree, gives a reason a
+person can read ("you said 90° but the plan turns 688°").
+
+Everything is derived from the robot profile: which skills move the base or
+the head (the part their description names, see `skill_parts`), the words
+for each part (keywords, aliases, the verbs of the descriptions), the
+direction words (what tells a skill from its `opposite`) and the numbers
+that stand in for vague amounts ([[conventions]]). No skill keyword is
+named below.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import re
+from collections.abc import Collection, Iterable
+from dataclasses import dataclass
+
+from agent.translate.clauses import _SHAPES
+from agent.translate.explain import quantity, say
+from rsl.compiler import compile_program
+from rsl.plan import ObjectRef, Plan, Quantity
+from rsl.profile import Profile
+
+_WORD = re.compile(r"[a-z]+")
+_NUMBER_UNIT = re.compile(r"(?<![\w.])(-?\d*\.?\d+)(?: (m|rad)\b)?")
+_COUNT = re.compile(r"\b(\d+) times\b")
+_FIRST_CLAUSE = re.compile(r"[.;]")
+# What negates what follows it up to the end of its clause ("don't move, just look left").
+_NEGATION = re.compile(r"\b(?:don'?t|do not|never|without|no|not)\b[^,.;]*")
+# The part of the robot that moves itself as a whole: the one a skill is on when its description names no part.
+WHOLE = "base"
+_TOLERANCE = 0.02
+
+
+@dataclass(frozen=True)
+class Doubt:
+    """One disagreement between the task and the plan; `reason` is said to the person."""
+
+    check: str
+    reason: str
+
+
+@dataclass(frozen=True)
+class _Vocabulary:
+    parts: dict[str, str]  # skill keyword -> part ("base", "head", "gripper")
+    part_words: dict[str, frozenset[str]]  # part -> words that name it or its skills, unshared
+    directions: tuple[tuple[str, frozenset[str], str, frozenset[str]], ...]  # (skill, words, opposite, words)
+    convention_numbers: dict[str, frozenset[float]]  # unit -> values the conventions use
+    convention_programs: tuple[tuple[str, frozenset[str]], ...]  # (phrase, skills of its program)
+    # (phrase, unit -> its values, whether it is a default: its phrase is not in its own example task)
+    amounts: tuple[tuple[str, dict[str, frozenset[float]], bool], ...]
+    coordinates: frozenset[str]  # skills whose numbers are positions, not amounts
+    skill_words: frozenset[str]  # keywords, aliases and direction words: never an object's name
+
+
+def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collection[str] | None = None
+                  ) -> tuple[Doubt, ...]:
+    """Every disagreement between the normalized `task` and `plan`; empty when they agree."""
+    vocab = _vocabulary(profile)
+    text = task.lower()
+    negated = " ".join(m.group(0) for m in _NEGATION.finditer(text))
+    affirmed = _NEGATION.sub(" ", text)
+    words = _words(affirmed, vocab)
+    doubts: list[Doubt] = []
+    doubts += _parts(plan, vocab, words, set(_WORD.findall(negated)), text, profile)
+    doubts += _directions(plan, vocab, words, profile)
+    doubts += _numbers(text, plan, vocab, profile)
+    doubts += _totals(text, plan, vocab)
+    doubts += _objects(text, plan, known_objects, vocab)
+    return tuple({d.reason: d for d in doubts}.values())
+
+
+def _words(text: str, vocab: _Vocabulary) -> set[str]:
+    """The task's words, with a pair that spells a skill word joined: "back up" is `backup`, "pick up" `pickup`."""
+    tokens = _WORD.findall(text)
+    return set(tokens) | {a + b for a, b in itertools.pairwise(tokens) if a + b in vocab.skill_words}
+
+
+def skill_parts(profile: Profile) -> dict[str, str]:
+    """Which part of the robot each skill moves: the part its description's first clause names.
+
+    The parts are the nouns of the robot's description ("a wheeled base, a
+    pan-tilt head with a camera, and a gripper"); a part "with" another (the
+    camera) belongs to it. A skill naming none moves the robot as a whole.
+    """
+    return dict(_vocabulary(profile).parts)
+
+
+def _robot_parts(profile: Profile) -> dict[str, str]:
+    """Part noun -> the part it belongs to: {"base": "base", "head": "head", "camera": "head", ...}."""
+    nouns: dict[str, str] = {}
+    for piece in re.split(r",|\band\b", profile.description.split(":", 1)[-1]):
+        owner, _, sub = piece.partition(" with ")
+        head_words = _WORD.findall(owner)
+        if not head_words:
+            continue
+        part = head_words[-1]
+        nouns[part] = part
+        sub_words = _WORD.findall(sub)
+        if sub_words:
+            nouns[sub_words[-1]] = part
+    nouns.setdefault(WHOLE, WHOLE)
+    return nouns
+
+
+def _build_vocabulary(profile: Profile) -> _Vocabulary:
+    nouns = _robot_parts(profile)
+    parts: dict[str, str] = {}
+    words: dict[str, set[str]] = {}
+    for skill in profile.skills:
+        clause = _FIRST_CLAUSE.split(skill.description, 1)[0].lower()
+        named = [nouns[w] for w in _WORD.findall(clause) if w in nouns]
+        part = named[0] if named else WHOLE
+        parts[skill.keyword] = part
+        verb = _WORD.findall(clause)[:1]
+        words.setdefault(part, set()).update({skill.keyword, *skill.aliases, *verb})
+    for noun, part in nouns.items():
+        words.setdefault(part, set()).add(noun)
+    # A shape ("walk a square") is traced by driving.
+    words.setdefault(WHOLE, set()).update(_SHAPES)
+    # A word several parts share ("right" in turnright and lookright) tells no part apart.
+    counted: dict[str, int] = {}
+    for found in words.values():
+        for word in found:
+            counted[word] = counted.get(word, 0) + 1
+    for keyword, part in parts.items():
+        for other, other_part in parts.items():
+            if other_part == part:
+                continue
+            for word in list(words[part]):
+                if len(word) >= 2 and word != keyword and word in other and word not in words[other_part]:
+                    counted[word] = counted.get(word, 0) + 1
+    directions = []
+    for skill in profile.skills:
+        opposite = profile.skill(skill.opposite) if skill.opposite else None
+        if opposite is not None and skill.keyword < opposite.keyword:
+            mine, theirs = _difference(skill.keyword, opposite.keyword)
+            # "for" tells forward from backward but is no direction a person says; the keyword is.
+            mine = mine if mine in skill.aliases else skill.keyword
+            theirs = theirs if theirs in opposite.aliases else opposite.keyword
+            directions.append((skill.keyword, frozenset({mine}), opposite.keyword, frozenset({theirs})))
+    # A direction ("up" in "pick up the cup") says which way, not which part.
+    direction_words = {w for d in directions for w in (*d[1], *d[3])}
+    part_words = {p: frozenset(w for w in ws if counted[w] == 1 and "_" not in w and w not in direction_words)
+                  for p, ws in words.items()}
+
+    coordinates = frozenset(s.keyword for s in profile.skills if any(p.is_coordinate for p in s.params))
+    numbers: dict[str, set[float]] = {}
+    programs = []
+    amounts = []
+    for convention in profile.conventions:
+        plan = compile_program(convention.program, profile).plan if convention.program else None
+        values: dict[str, set[float]] = {}
+        for command in plan or ():
+            if command.skill in coordinates:
+                continue
+            for arg in command.args:
+                if isinstance(arg, Quantity):
+                    values.setdefault(arg.unit, set()).add(abs(arg.value))
+        for value, unit in _NUMBER_UNIT.findall(convention.meaning):
+            if unit:
+                values.setdefault(unit, set()).add(abs(float(value)))
+        for unit, unit_values in values.items():
+            numbers.setdefault(unit, set()).update(unit_values)
+        amounts.append((convention.phrase, {u: frozenset(v) for u, v in values.items()},
+                        convention.phrase not in convention.task))
+        if plan is not None:
+            programs.append((convention.phrase, frozenset(c.skill for c in plan)))
+    return _Vocabulary(parts=parts, part_words=part_words, directions=tuple(directions),
+                       convention_numbers={u: frozenset(v) for u, v in numbers.items()},
+                       convention_programs=tuple(programs), amounts=tuple(amounts), coordinates=coordinates,
+                       skill_words=frozenset({w for ws in words.values() for w in ws} - set(nouns)
+                                             | direction_words))
+
+
+_VOCABULARIES: dict[str, _Vocabulary] = {}
+
+
+def _vocabulary(profile: Profile) -> _Vocabulary:
+    found = _VOCABULARIES.get(profile.digest)
+    if found is None:
+        found = _VOCABULARIES[profile.digest] = _build_vocabulary(profile)
+    return found
+
+
+def _difference(a: str, b: str) -> tuple[str, str]:
+    """What tells two keywords apart: turnleft/turnright -> left/right; forward/backward stay whole."""
+    start = 0
+    while start < min(len(a), len(b)) and a[start] == b[start]:
+        start += 1
+    end = 0
+    while end < min(len(a), len(b)) - start and a[-1 - end] == b[-1 - end]:
+        end += 1
+    start = start if start >= 3 else 0
+    end = end if end >= 3 else 0
+    return a[start:len(a) - end], b[start:len(b) - end]
+
+
+def _said(words: Iterable[str], direction: frozenset[str]) -> bool:
+    return any(w == d or (len(w) >= 4 and d.startswith(w)) or (len(d) >= 4 and w.startswith(d))
+               for w in words for d in direction)
+
+
+def _parts(plan: Plan, vocab: _Vocabulary, words: set[str], negated: set[str], text: str,
+           profile: Profile) -> list[Doubt]:
+    """The base moves only when asked for motion; a request about the head moves only the head."""
+    used = {vocab.parts.get(c.skill, WHOLE) for c in plan}
+    allowed = {skill for phrase, skills in vocab.convention_programs if phrase in text for skill in skills}
+    asked = {part for part, ws in vocab.part_words.items() if words & ws}
+    doubts = []
+    for part in sorted(used):
+        moving = [c for c in plan if vocab.parts.get(c.skill) == part and c.skill not in allowed]
+        if not moving or part in asked:
+            continue
+        example = say(moving[0], profile)
+        if negated & vocab.part_words.get(part, frozenset()):
+            doubts.append(Doubt("negation", f"you said not to move the {part}, but the plan does ({example})"))
+        elif asked:
+            said = " or ".join(f"the {p}" for p in sorted(asked))
+            doubts.append(Doubt("part", f"you asked about {said}, but the plan moves the {part} ({example})"))
+        elif part == WHOLE:
+            doubts.append(Doubt("motion", f"you did not ask the robot to move, but the plan does ({example})"))
+    for part in sorted(asked - used - {WHOLE}):
+        doubts.append(Doubt("part", f"you asked about the {part}, but the plan never uses it"))
+    return doubts
+
+
+def _directions(plan: Plan, vocab: _Vocabulary, words: set[str], profile: Profile) -> list[Doubt]:
+    doubts = []
+    for skill, mine, opposite, theirs in vocab.directions:
+        for said_words, unsaid_words, wrong in ((mine, theirs, opposite), (theirs, mine, skill)):
+            if _said(words, said_words) and not _said(words, unsaid_words):
+                hit = next((c for c in plan if c.skill == wrong), None)
+                if hit is not None:
+                    doubts.append(Doubt("direction", f"you said {min(said_words)}, but the plan goes the "
+                                                     f"other way ({say(hit, profile)})"))
+    return doubts
+
+
+def _said_numbers(text: str) -> list[tuple[float, str]]:
+    counts = {m.start(1) for m in _COUNT.finditer(text)}
+    return [(abs(float(m.group(1))), m.group(2) or "") for m in _NUMBER_UNIT.finditer(text)
+            if m.start(1) not in counts]
+
+
+def _counts(text: str) -> int:
+    count = 1
+    for found in _COUNT.findall(text):
+        count *= max(1, int(found))
+    for shape, sides in _SHAPES.items():
+        if re.search(rf"\b{shape}\b", text):
+            count *= sides
+    return count
+
+
+def _close(a: float, b: float) -> bool:
+    return abs(a - b) <= max(_TOLERANCE, 0.01 * abs(b))
+
+
+def _numbers(text: str, plan: Plan, vocab: _Vocabulary, profile: Profile) -> list[Doubt]:
+    """Every number said is in the plan; every number in the plan was said or is a convention's."""
+    said = _said_numbers(text)
+    planned = [(abs(a.value), a.unit, c) for c in plan for a in c.args if isinstance(a, Quantity)]
+    amounts = [(v, u, c) for v, u, c in planned if c.skill not in vocab.coordinates]
+    doubts = []
+    for value, unit in said:
+        if not any(_close(v, value) and (not unit or u == unit) for v, u, _c in planned):
+            shown = quantity(Quantity(value, unit)) if unit else f"{value:g}"
+            doubts.append(Doubt("number", f"you said {shown}, but the plan never uses it"))
+    count = _counts(text)
+    shape_turns = {2 * math.pi / n for n in _SHAPES.values()}
+    for value, unit, command in amounts:
+        said_here = [v for v, u in said if not u or u == unit]
+        if any(_close(value, v * k) for v in said_here for k in range(1, count + 1)):
+            continue
+        if not said_here and any(_close(value, v) for v in vocab.convention_numbers.get(unit, ())):
+            continue
+        if unit == "rad" and any(_close(value, t) for t in shape_turns):
+            continue
+        doubts.append(Doubt("number", f"the plan uses {quantity(Quantity(value, unit))} "
+                                      f"({say(command, profile)}), which you did not say"))
+    return doubts
+
+
+def _totals(text: str, plan: Plan, vocab: _Vocabulary) -> list[Doubt]:
+    """The whole turn and the whole drive of the base fit what was said."""
+    count = _counts(text)
+    said = _said_numbers(text)
+    doubts = []
+    for unit, noun, verb in (("rad", "turn", "turns"), ("m", "distance", "drives")):
+        moves = [c for c in plan if vocab.parts.get(c.skill) == WHOLE and c.skill not in vocab.coordinates]
+        planned = sum(abs(a.value) for c in moves for a in c.args if isinstance(a, Quantity) and a.unit == unit)
+        if planned == 0:
+            continue
+        said_total = sum(v for v, u in said if u == unit)
+        if said_total == 0:
+            said_total = _vague_amount(text, vocab, unit)
+        limit = said_total * count
+        if planned > max(limit, 2 * math.pi if unit == "rad" else 0.0) * 1.01 + _TOLERANCE:
+            doubts.append(Doubt("total", f"you said {quantity(Quantity(limit, unit))} of {noun} in all, "
+                                         f"but the plan {verb} {quantity(Quantity(planned, unit))}"))
+    return doubts
+
+
+def _vague_amount(text: str, vocab: _Vocabulary, unit: str) -> float:
+    """The most a task that says no number may mean: its conventions' amounts, else the defaults'."""
+    used = [values for phrase, values, _default in vocab.amounts if phrase in text]
+    if not used:
+        used = [values for _phrase, values, default in vocab.amounts if default]
+    return max((v for values in used for v in values.get(unit, ())), default=0.0)
+
+
+def _objects(text: str, plan: Plan, known: Collection[str] | None, vocab: _Vocabulary) -> list[Doubt]:
+    """Every object in the plan was said, and every known object said is in the plan."""
+    words = set(_WORD.findall(text))
+    planned = {a.name for c in plan for a in c.args if isinstance(a, ObjectRef)}
+    doubts = []
+    for name in sorted(planned):
+        if name.lower() in vocab.skill_words:
+            doubts.append(Doubt("object", f"the plan takes '{name}' for an object, but it names a direction "
+                                          "or an action"))
+        elif not (set(name.lower().split("_")) & words):
+            doubts.append(Doubt("object", f"the plan uses the {name.replace('_', ' ')}, which you did not mention"))
+    for name in sorted(known or ()) if planned else ():
+        parts = name.lower().split("_")
+        if all(p in words for p in parts) and not any(set(parts) <= set(p.split("_")) for p in planned):
+            doubts.append(Doubt("object", f"you mentioned the {name.replace('_', ' ')}, but the plan never uses it"))
+    return doubts

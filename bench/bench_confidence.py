@@ -1,0 +1,123 @@
+"""Knowing when not to act: how often a wrong program would run without a question, and what asking costs.
+
+Translates every task of a suite with the shipped adapter and, for each,
+records whether the plan is right (the suite's `accepts`), its confidence and
+whether the default policy (`translator.confirm = "unsure"`) would ask.
+Writes aggregates only:
+
+- wrong_runs_unasked: share of all items that end as a wrong program the robot would run without asking;
+- right_questioned: share of the right programs the policy would question;
+- refusal: share of non-tasks with no program, and of tasks refused as non-tasks;
+- auroc: how well the confidence ranks right plans above wrong ones (verified plans only);
+- coverage_curve: accuracy of the plans kept when only those at or above a confidence are run;
+- checks_ms p50/p95: the added time of the meaning checks, explanation and confidence per translation.
+
+    python bench/bench_confidence.py [--suite FILE] [--out FILE] [--every K]
+
+The frozen development set (bench/fresh/dev.toml) is measured, never tuned on: per-task results are
+written only for the evaluation suite, which the thresholds were chosen on.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from agent.evalsuite import load_suite
+from agent.evalsuite.runner import percentile
+from agent.evalsuite.suite import accepts, suite_path
+from agent.normalize import normalize_task
+from agent.translate import Translator
+from agent.translate.confidence import UNSURE_BELOW, judge
+from rsl.profile import load_profile
+
+
+def auroc(positives: list[float], negatives: list[float]) -> float | None:
+    """The chance a right plan scores above a wrong one (ties count half)."""
+    if not positives or not negatives:
+        return None
+    wins = sum(1.0 if p > n else 0.5 if p == n else 0.0 for p in positives for n in negatives)
+    return wins / (len(positives) * len(negatives))
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--suite", metavar="FILE", help="suite file (default: the evaluation suite)")
+    parser.add_argument("--every", type=int, default=1, metavar="K", help="only every K-th task (default: all)")
+    parser.add_argument("--out", default="bench/results/confidence_suite.json")
+    parser.add_argument("--per-task", action="store_true",
+                        help="also write each task's outcome (only for sets that may be looked at)")
+    args = parser.parse_args()
+
+    profile = load_profile()
+    tasks = load_suite(args.suite, profile)[:: max(1, args.every)]
+    translator = Translator.load(profile, adapter="default")
+    rows: list[dict[str, Any]] = []
+    checks_ms: list[float] = []
+    started = time.monotonic()
+    for index, task in enumerate(tasks, 1):
+        result = translator.translate(task.task, known_objects=task.objects)
+        if result.plan is not None:
+            # The checks, explanation and confidence again, timed alone and side by side with the translation.
+            begin = time.perf_counter()
+            judge(normalize_task(task.task), result.plan, profile, (), task.objects)
+            checks_ms.append((time.perf_counter() - begin) * 1000)
+        rows.append({"task": task.task, "group": task.group, "refuse": task.refuse, "program": result.program,
+                     "verified": result.verified, "right": accepts(task, result.plan, profile),
+                     "confidence": result.confidence, "confirm": result.confirm, "refused": result.refused,
+                     "doubts": list(result.doubts), "total_ms": result.timings_ms.get("total", 0.0)})
+        print(f"\r{index}/{len(tasks)} {time.monotonic() - started:.0f} s", end="", file=sys.stderr, flush=True)
+    print(file=sys.stderr)
+    translator.close()
+
+    items = len(rows)
+    real = [r for r in rows if not r["refuse"]]
+    chat = [r for r in rows if r["refuse"]]
+    ran = [r for r in rows if r["verified"]]
+    right = [r for r in ran if r["right"]]
+    wrong = [r for r in ran if not r["right"]]
+    curve = []
+    for threshold in (0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 0.95, 0.99, 1.0):
+        kept = [r for r in ran if (r["confidence"] or 0.0) >= threshold]
+        curve.append({"threshold": threshold, "coverage": len(kept) / len(ran) if ran else 0.0,
+                      "accuracy": sum(r["right"] for r in kept) / len(kept) if kept else None})
+    summary: dict[str, Any] = {
+        "suite": str(args.suite or suite_path()),
+        "items": items, "tasks": len(real), "non_tasks": len(chat),
+        "unsure_below": UNSURE_BELOW,
+        "wrong_runs_unasked": sum(1 for r in wrong if not r["confirm"]) / items,
+        "wrong_runs_if_never_asked": len(wrong) / items,
+        "wrong_runs_questioned": sum(1 for r in wrong if r["confirm"]) / len(wrong) if wrong else None,
+        "right_questioned": sum(1 for r in right if r["confirm"]) / len(right) if right else None,
+        "right_programs": len(right), "wrong_programs": len(wrong),
+        "non_tasks_refused": sum(1 for r in chat if not r["verified"]) / len(chat) if chat else None,
+        "non_tasks_refused_e201": sum(1 for r in chat if r["refused"]) / len(chat) if chat else None,
+        "non_tasks_asked_or_refused": (sum(1 for r in chat if not r["verified"] or r["confirm"]) / len(chat)
+                                       if chat else None),
+        "tasks_refused_e201": sum(1 for r in real if r["refused"]) / len(real) if real else None,
+        "tasks_right": sum(1 for r in real if r["right"]) / len(real) if real else None,
+        "auroc": auroc([r["confidence"] for r in right], [r["confidence"] for r in wrong]),
+        "coverage_curve": curve,
+        "checks_ms_p50": percentile(checks_ms, 0.5), "checks_ms_p95": percentile(checks_ms, 0.95),
+        "translate_ms_p50": percentile([r["total_ms"] for r in rows], 0.5),
+        "machine": {"cpus": os.cpu_count(), "load_avg": os.getloadavg(), "python": platform.python_version(),
+                    "note": "2 shared cores, other helpers running at the same time"},
+        "wall_s": round(time.monotonic() - started, 1),
+    }
+    if args.per_task:
+        summary["per_task"] = rows
+    out = Path(args.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
+    print(json.dumps({k: v for k, v in summary.items() if k not in ("per_task", "coverage_curve")}, indent=2))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

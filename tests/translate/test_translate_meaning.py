@@ -1,0 +1,99 @@
+"""Explain-back and the meaning checks, on plans written by hand: no model needed."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from agent.normalize import normalize_task
+from agent.translate.confidence import UNSURE_BELOW, assess
+from agent.translate.explain import capabilities, explain
+from agent.translate.meaning import check_meaning, skill_parts
+from rsl.compiler import compile_program
+from rsl.plan import Plan
+from rsl.profile import Profile, load_profile, parse_profile
+
+
+@pytest.fixture(scope="module")
+def profile() -> Profile:
+    return load_profile()
+
+
+def plan(program: str, profile: Profile) -> Plan:
+    compiled = compile_program(program, profile)
+    assert compiled.plan is not None, compiled.diagnostics
+    return compiled.plan
+
+
+def reasons(task: str, program: str, profile: Profile, known: list[str] | None = None) -> list[str]:
+    return [d.reason for d in check_meaning(normalize_task(task), plan(program, profile), profile, known)]
+
+
+def test_the_plan_is_said_in_the_units_people_use(profile: Profile) -> None:
+    said = explain(plan("forward 3; turnright 1.5708; grasp box; forward 0.25; turnleft 0.5; turnleft 0.5;",
+                        profile), profile)
+    assert said == ("drive forward 3 m, then turn right 90°, then pick up the box, then drive forward 25 cm, "
+                    "then turn left 29° (2 times)")
+
+
+def test_a_skill_without_wording_is_said_from_its_description(profile: Profile) -> None:
+    text = re.sub(r"^say = .*\n", "", Path(profile.source).read_text(encoding="utf-8"), flags=re.M)
+    bare = parse_profile(text)
+    assert explain(plan("forward 3; grasp box;", bare), bare) == (
+        "drive straight ahead by 3 m, then pick up the box that is within reach of the gripper")
+
+
+def test_what_the_robot_can_do_comes_from_the_profile(profile: Profile) -> None:
+    text = capabilities(profile)
+    assert all(s.description.split(".")[0].lower()[:20] in text.lower() for s in profile.skills)
+
+
+def test_parts_come_from_the_descriptions(profile: Profile) -> None:
+    parts = skill_parts(profile)
+    assert {k for k, v in parts.items() if v == "head"} == {"lookup", "lookdown", "lookleft", "lookright", "perceive"}
+    assert parts["grasp"] == "gripper" and parts["forward"] == parts["turnleft"] == parts["goto"] == "base"
+
+
+@pytest.mark.parametrize(("task", "program", "expected"), [
+    ("turn left three times ninety degrees", "turnleft 3; turnleft 3; turnleft 3; turnleft 3;",
+     "you said 270° of turn in all, but the plan turns 688°"),
+    ("thank you, goodbye", "forward 1;", "you did not ask the robot to move, but the plan does (drive forward 1 m)"),
+    ("pan the head left", "turnleft 1.5708;", "you asked about the head, but the plan moves the base (turn left 90°)"),
+    ("don't move, just look left", "turnleft 1.5708; lookleft 0.5236;",
+     "you said not to move the base, but the plan does (turn left 90°)"),
+    ("repeat a turn until a full circle", "turnleft 6.2832; turnleft 6.2832; turnleft 6.2832;",
+     "you said 360° of turn in all, but the plan turns 1080°"),
+    ("turn right 90 degrees", "turnleft 1.5708;", "you said right, but the plan goes the other way (turn left 90°)"),
+    ("go back 1 meter", "forward 1;", "you said back, but the plan goes the other way (drive forward 1 m)"),
+    ("grasp the cup", "grasp box;", "the plan uses the box, which you did not mention"),
+    ("drive forward 2 meters", "forward 3;", "you said 2 m, but the plan never uses it"),
+    ("move the head right, then forward 0.3 meters", "approach right; forward 0.3;",
+     "the plan takes 'right' for an object, but it names a direction or an action"),
+])
+def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str, expected: str,
+                                                         profile: Profile) -> None:
+    assert expected in reasons(task, program, profile, ["cup", "box"])
+    assert assess(normalize_task(task), plan(program, profile), profile).confidence < UNSURE_BELOW
+
+
+@pytest.mark.parametrize(("task", "program"), [
+    ("move forward two meters, then grasp the cup", "forward 2; grasp cup;"),
+    ("walk in a square of 1 meter", "forward 1; turnleft 1.5708; " * 4),
+    ("look around", "lookleft 1.5708; perceive; lookright 3.1416; perceive; lookleft 1.5708;"),
+    ("go back to the start", "goto 0, 0;"),
+    ("go to 1, 2", "goto 1, 2;"),
+    ("move forward a little", "forward 0.2;"),
+    ("turn left", "turnleft 1.5708;"),
+    ("look left", "lookleft 0.5236;"),
+    ("turn around", "turnleft 3.1416;"),
+    ("turn left 90 degrees 3 times", "turnleft 1.5708; turnleft 1.5708; turnleft 1.5708;"),
+    ("approach the table and pick up the cup", "approach table; grasp cup;"),
+    ("back up 0.7 meters", "backward 0.7;"),
+    ("look around and then find the keys",
+     "lookleft 1.5708; perceive; lookright 3.1416; perceive; lookleft 1.5708; perceive;"),
+])
+def test_a_plan_that_does_what_was_said_has_no_doubt(task: str, program: str, profile: Profile) -> None:
+    assert reasons(task, program, profile, ["cup", "table", "keys"]) == []
+    assert assess(normalize_task(task), plan(program, profile), profile, model=0.9).confidence == 0.9
