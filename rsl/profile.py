@@ -342,12 +342,13 @@ _LANGUAGE_KEYS = ("keyword", "description", "example", "aliases", "opposite", "p
 def _language_digest(data: dict[str, Any]) -> str:
     """The digest of the language a profile defines: what an adapter's card pins.
 
-    It covers each skill's statement and meaning, the conventions, the
-    workspace and the statement limit: the things the prompt and the training
+    It covers the robot's name, each skill's statement and meaning, the
+    conventions, the workspace and the statement limit: the things the prompt and the training
     data are made of. Rebinding a skill, rewording how it is explained or
     changing a joint limit keeps the adapter; renaming a skill does not.
     """
     language = {
+        "robot": data.get("robot", {}).get("name"),
         "skills": [{key: skill.get(key) for key in _LANGUAGE_KEYS} for skill in data.get("skills", [])],
         "conventions": data.get("conventions", []),
         "workspace": data.get("workspace", {}),

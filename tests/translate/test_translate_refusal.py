@@ -8,7 +8,7 @@ import pytest
 
 from agent.translate import Translator
 from agent.translate.automaton import END, START, RslAutomaton
-from agent.translate.engine import Generation, TokenMasks
+from agent.translate.engine import CancelFlag, Generation, TokenMasks
 from rsl.diagnostics import Code
 from rsl.grammar import to_gbnf
 from rsl.profile import Profile
@@ -60,7 +60,8 @@ class _PrimedEngine:
         self.engine = engine
         self.prompts: list[str] = []
 
-    def generate(self, prompt: str, automaton: RslAutomaton | None, max_tokens: int) -> Generation:
+    def generate(self, prompt: str, automaton: RslAutomaton | None, max_tokens: int,
+                 cancel: CancelFlag | None = None) -> Generation:
         self.prompts.append(prompt)
         shots = "".join(f"Task: {t}\nRSL:\n{REFUSAL}" for t in ("tell me a joke", "hello there", "how are you"))
         return self.engine.generate(shots + "Task: what time is it\nRSL:\n", automaton, max_tokens)  # type: ignore[attr-defined]
