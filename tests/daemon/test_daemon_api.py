@@ -146,7 +146,9 @@ def test_cancel_a_queued_and_a_running_task(daemon: Daemon) -> None:
 
 def test_fifty_concurrent_clients_get_a_task_or_a_clear_busy(daemon: Daemon) -> None:
     with daemon.client() as holder:
-        blocker = holder.submit(rsl="forward 2;")
+        # Earlier tests leave the robot wherever a cancel caught it, perhaps against the table, where the
+        # bumper would fail the turns below: back away to open floor at the start, turning there to keep busy.
+        blocker = holder.submit(rsl="backward 1; goto 0, 0; turnleft 3.1416;")
         while holder.status(blocker)["state"] == "queued":
             time.sleep(0.05)
         results: list[str] = []
