@@ -71,6 +71,53 @@ class WakeHit:
     wake_end_s: float | None
 
 
+class SpeechGate:
+    """Lets audio through to a recogniser only around loud stretches.
+
+    Hours of silence fed to Vosk drift its speaker adaptation until it stops
+    hearing the words it spots (and cost CPU); so quiet audio only fills a
+    short lead-in, handed over when speech starts, and a stretch of speech
+    ends after a hangover of quiet.
+    """
+
+    def __init__(self, rate: int, hangover_s: float) -> None:
+        self.rate = rate
+        self.noise = NoiseFloor()
+        self.lead: deque[bytes] = deque()
+        self.hangover_samples = int(hangover_s * rate)
+        self.active = False
+        self.quiet_samples = 0
+
+    def admit(self, block: bytes) -> list[bytes]:
+        """The blocks to decode now: none while quiet, the lead-in and `block` when speech starts, else `block`."""
+        loud = self.noise.is_loud(block)
+        if not self.active:
+            if not loud:
+                self.lead.append(block)
+                while sum(len(b) for b in self.lead) // 2 > LEAD_IN_S * self.rate:
+                    self.lead.popleft()
+                return []
+            self.active = True
+            self.quiet_samples = 0
+            blocks, self.lead = [*self.lead, block], deque()
+            return blocks
+        self.quiet_samples = 0 if loud else self.quiet_samples + len(block) // 2
+        return [block]
+
+    @property
+    def ended(self) -> bool:
+        """A stretch of speech was going on and has been quiet for the whole hangover."""
+        return self.active and self.quiet_samples >= self.hangover_samples
+
+    def close(self) -> None:
+        self.active = False
+        self.quiet_samples = 0
+
+    def reset(self) -> None:
+        self.lead.clear()
+        self.close()
+
+
 class WakeSpotter:
     """Feeds the keyword recogniser only around loud audio.
 
@@ -84,46 +131,26 @@ class WakeSpotter:
         self.recognizer = recognizer
         recognizer.recognizer.SetMaxAlternatives(WAKE_ALTERNATIVES)
         self.phrases = [tuple(w.lower().split()) for w in wake_words if w.split()]
-        self.noise = NoiseFloor()
-        self.lead: deque[bytes] = deque()
+        self.gate = SpeechGate(recognizer.rate, hangover_s)
         self.audio: deque[bytes] = deque()
         self.audio_samples = 0
         self.max_samples = int(preroll_s * recognizer.rate)
-        self.hangover_samples = int(hangover_s * recognizer.rate)
-        self.active = False
-        self.quiet_samples = 0
 
     def feed(self, block: bytes) -> WakeHit | None:
-        loud = self.noise.is_loud(block)
-        if not self.active:
-            if not loud:
-                self.lead.append(block)
-                while sum(len(b) for b in self.lead) // 2 > LEAD_IN_S * self.recognizer.rate:
-                    self.lead.popleft()
-                return None
-            self.active = True
-            self.quiet_samples = 0
-            lead, self.lead = list(self.lead), deque()
-            for earlier in lead:
-                hit = self._accept(earlier)
-                if hit is not None:
-                    return self._close(hit)
-        self.quiet_samples = 0 if loud else self.quiet_samples + len(block) // 2
-        hit = self._accept(block)
-        if hit is not None:
-            return self._close(hit)
-        if self.quiet_samples >= self.hangover_samples:
+        for piece in self.gate.admit(block):
+            hit = self._accept(piece)
+            if hit is not None:
+                return self._close(hit)
+        if self.gate.ended:
             return self._close(self._judge(self.recognizer.result(False), heard_in_partial=False))
         return None
 
     def reset(self) -> None:
         """Forget the stretch in progress: it was a stop, not the start of a task."""
         self.recognizer.reset()
-        self.lead.clear()
+        self.gate.reset()
         self.audio.clear()
         self.audio_samples = 0
-        self.active = False
-        self.quiet_samples = 0
 
     def _accept(self, block: bytes) -> WakeHit | None:
         self.audio.append(block)
@@ -153,9 +180,8 @@ class WakeSpotter:
         return WakeHit(audio, max(0.0, end - audio_start))
 
     def _close(self, hit: WakeHit | None) -> WakeHit | None:
-        if hit is not None or self.quiet_samples >= self.hangover_samples:
-            self.active = False
-            self.quiet_samples = 0
+        if hit is not None or self.gate.ended:
+            self.gate.close()
         return hit
 
     def _mentions_wake_word(self, text: str) -> bool:

@@ -14,13 +14,11 @@ false alarms per threshold).
 
 from __future__ import annotations
 
-from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from agent.speech.endpoint import NoiseFloor
-from agent.speech.spotting import HANGOVER_S, LEAD_IN_S, TimedRecognizer, keyword_grammar
+from agent.speech.spotting import HANGOVER_S, SpeechGate, TimedRecognizer, keyword_grammar
 from agent.speech.vocabulary import Vocabulary
 
 
@@ -43,41 +41,27 @@ class StopSpotter:
         self.recognizer = recognizer
         self.stop_words = frozenset(w.lower() for w in stop_words)
         self.threshold = threshold
-        self.noise = NoiseFloor()
-        self.lead: deque[bytes] = deque()
-        self.hangover_samples = int(hangover_s * recognizer.rate)
-        self.active = False
-        self.quiet_samples = 0
+        self.gate = SpeechGate(recognizer.rate, hangover_s)
+
+    @property
+    def active(self) -> bool:
+        """Within a stretch of speech."""
+        return self.gate.active
 
     def feed(self, block: bytes) -> StopHeard | None:
-        # Gated by loudness like the wake spotter: hours of quiet drift Vosk's adaptation and cost CPU.
-        loud = self.noise.is_loud(block)
-        if not self.active:
-            if not loud:
-                self.lead.append(block)
-                while sum(len(b) for b in self.lead) // 2 > LEAD_IN_S * self.recognizer.rate:
-                    self.lead.popleft()
-                return None
-            self.active = True
-            self.quiet_samples = 0
-            lead, self.lead = list(self.lead), deque()
-            for earlier in lead:
-                heard = self._accept(earlier)
-                if heard is not None:
-                    return heard
-        self.quiet_samples = 0 if loud else self.quiet_samples + len(block) // 2
-        heard = self._accept(block)
-        if heard is None and self.quiet_samples >= self.hangover_samples:
-            heard = self._judge(self.recognizer.result(False))
-            self.active = False
-        return heard
+        for piece in self.gate.admit(block):
+            heard = self._accept(piece)
+            if heard is not None:
+                return heard
+        if self.gate.ended:
+            self.gate.close()
+            return self._judge(self.recognizer.result(False))
+        return None
 
     def reset(self) -> None:
         """Forget the stretch in progress (the robot stopped moving, say)."""
         self.recognizer.reset()
-        self.lead.clear()
-        self.active = False
-        self.quiet_samples = 0
+        self.gate.reset()
 
     def _accept(self, block: bytes) -> StopHeard | None:
         if self.recognizer.accept(block):
