@@ -29,7 +29,10 @@ class Request:
         return self.body.get("id")
 
 
-@dataclass(frozen=True)
+# Not frozen: Python writes `__traceback__` on an exception as it leaves a
+# `with` block, and a frozen one turns into FrozenInstanceError there. No
+# `eq`, so it stays hashable by identity like any exception.
+@dataclass(eq=False)
 class ProtocolError(Exception):
     code: str
     message: str

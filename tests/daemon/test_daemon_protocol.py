@@ -3,8 +3,11 @@
 from __future__ import annotations
 
 import json
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from jsonschema import Draft202012Validator
@@ -103,3 +106,14 @@ def test_schemas_are_valid_and_documented() -> None:
         "docs/api.md is stale: replace its schema part with `nrtrans serve --api-doc`"
     )
     assert json.dumps(REQUESTS["submit"], indent=2) in api_md
+
+
+def test_a_protocol_error_passes_through_a_with_block_unchanged() -> None:
+    """Python sets `__traceback__` on an exception leaving a generator context manager; a frozen one broke."""
+    @contextmanager
+    def guarded() -> Iterator[None]:
+        yield
+
+    with pytest.raises(ProtocolError) as raised, guarded():
+        raise ProtocolError("busy", "the task queue is full")
+    assert raised.value.code == "busy"

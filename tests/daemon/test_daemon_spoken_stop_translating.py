@@ -46,6 +46,10 @@ def test_a_spoken_stop_ends_a_translation_with_the_queue_full(service: Service) 
     service.events.subscribe(record)
     before = service.robot.state().pose
     running, _ = service.submit(source="api", text=LONG_TASK)
+    # The queue holds one: the second task fits only once the worker has taken the first.
+    deadline = time.monotonic() + 30
+    while running.state is TaskState.QUEUED and time.monotonic() < deadline:
+        time.sleep(0.01)
     queued, _ = service.submit(source="api", rsl="turnleft 1;")
     assert translating.wait(60), seen
     time.sleep(0.2)
