@@ -11,6 +11,7 @@ For convenience (tests, generated Python) a backend also answers
 from __future__ import annotations
 
 import threading
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import Enum
 from typing import Protocol, runtime_checkable
@@ -112,3 +113,23 @@ class Robot(Protocol):
     def state(self) -> RobotState: ...
 
     def close(self) -> None: ...
+
+
+class SkillCalls:
+    """`robot.<keyword>(...)` for every skill of the robot's profile, as generated Python and tests call it.
+
+    A backend mixes this in beside its `profile` and `perform`.
+    """
+
+    profile: Profile
+    perform: Callable[..., Outcome]
+
+    def __getattr__(self, name: str) -> Callable[..., Outcome]:
+        profile = self.__dict__.get("profile")
+        skill = profile.skill(name) if profile is not None else None
+        if skill is None:
+            raise AttributeError(name)
+
+        def run(*args: float | str, cancel: CancelToken | None = None) -> Outcome:
+            return self.perform(skill, args, cancel=cancel)
+        return run

@@ -25,7 +25,7 @@ import time
 from collections.abc import Callable
 
 from agent.executor import navigate_point
-from agent.robot import CancelToken, Outcome, Pose, RobotState, approach_first
+from agent.robot import CancelToken, Outcome, Pose, RobotState, SkillCalls, approach_first
 from agent.ros2.bindings import BindingFailure, BoundSkills
 from agent.ros2.config import RosConfig
 from agent.ros2.geometry import footprint_radius, wrap_angle
@@ -53,7 +53,7 @@ class StepFailure(Exception):
     """Ends a step with a failed outcome; the message is the reason."""
 
 
-class Ros2Robot:
+class Ros2Robot(SkillCalls):
     backend_name = "ros2"
 
     def __init__(self, profile: Profile, *, config: RosConfig | None = None,
@@ -206,17 +206,6 @@ class Ros2Robot:
             holding=self._holding_now(),
             known_objects=tuple((n, x, y) for n, (x, y) in sorted(known.items())),
         )
-
-    def __getattr__(self, name: str) -> Callable[..., Outcome]:
-        # `robot.<keyword>(...)` for every skill of the profile, as generated Python and tests call it.
-        profile = self.__dict__.get("profile")
-        skill = profile.skill(name) if profile is not None else None
-        if skill is None:
-            raise AttributeError(name)
-
-        def run(*args: float | str, cancel: CancelToken | None = None) -> Outcome:
-            return self.perform(skill, args, cancel=cancel)
-        return run
 
     def close(self) -> None:
         if self._closed:

@@ -22,7 +22,7 @@ import threading
 from collections.abc import Callable
 
 from agent.executor import navigate_point, travel_time
-from agent.robot import CancelToken, Outcome, Pose, RobotState, approach_first
+from agent.robot import CancelToken, Outcome, Pose, RobotState, SkillCalls, approach_first
 from agent.sim.scene import Scene
 from agent.sim.world import GRASP_BEARING, Contact, SimWorld
 from rsl.profile import Profile, RosBinding, Skill
@@ -49,7 +49,7 @@ class _Blocked(Exception):
     """A motion ran out of its time budget."""
 
 
-class SimRobot:
+class SimRobot(SkillCalls):
     """A mobile manipulator in a pybullet world; the default backend when no robot is configured."""
 
     backend_name = "sim"
@@ -98,17 +98,6 @@ class SimRobot:
         if binding.name == "perceive_objects":
             return self._run(cancel, self._perceive)
         return self._run(cancel, lambda token: self._grasp(str(args[0]), token))
-
-    def __getattr__(self, name: str) -> Callable[..., Outcome]:
-        # `robot.<keyword>(...)` for every skill of the profile, as generated Python and tests call it.
-        profile = self.__dict__.get("profile")
-        skill = profile.skill(name) if profile is not None else None
-        if skill is None:
-            raise AttributeError(name)
-
-        def run(*args: float | str, cancel: CancelToken | None = None) -> Outcome:
-            return self.perform(skill, args, cancel=cancel)
-        return run
 
     def _navigate(self, x: float, y: float, token: CancelToken) -> Outcome:
         self._check_workspace(x, y, f"the point ({x:g}, {y:g})")
