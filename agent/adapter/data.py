@@ -393,6 +393,14 @@ class Generator:
         word = number_words(deg) if rng.random() < 0.3 else str(deg)
         return f"{word} " + self._pick(("degrees", "degrees", "deg", "degree"))
 
+    def _amount(self, role: Role) -> tuple[float, str]:
+        """A random amount for a drive or turn, and how a person says it."""
+        if role.kind == "drive":
+            value = self._distance(role)
+            return value, self._say_distance(value)
+        degrees, angle = self._angle(role)
+        return angle, self._say_angle(degrees, angle)
+
     def _distance(self, role: Role) -> float:
         param = role.skill.params[0]
         low, high = param.min or 0.01, param.max or 10.0
@@ -441,12 +449,7 @@ class Generator:
             return Clause(self._pick(VAGUE[key]).format(v=amount.phrase), (self._cmd(role, amount.value),))
         if default is not None and (style == "bare" or (style == "any" and r < 0.22)):
             return Clause(self._pick(BARE[key]), (self._cmd(role, default.value),))
-        if role.kind == "drive":
-            value = self._distance(role)
-            said = self._say_distance(value)
-        else:
-            degrees, value = self._angle(role)
-            said = self._say_angle(degrees, value)
+        value, said = self._amount(role)
         templates = PHRASES[key] + tuple(f"{a} {{a}}" for a in self._alias_verbs(role))
         return Clause(self._pick(templates).format(a=said), (self._cmd(role, value),))
 
@@ -602,12 +605,7 @@ class Generator:
             # "turn left 3 times 90 degrees": the count inside one clause.
             role = self._motion_role()
             key = (role.kind, role.direction)
-            if role.kind == "drive":
-                value = self._distance(role)
-                said = self._say_distance(value)
-            else:
-                degrees, value = self._angle(role)
-                said = self._say_angle(degrees, value)
+            value, said = self._amount(role)
             template = self._pick([t for t in PHRASES[key] if t.endswith("{a}")])
             text = self._pick((template.format(a=f"{times} {said}"), f"{times} {template.format(a=said)}",
                                f"{template.format(a=said)}, {times} in a row"))
