@@ -186,6 +186,15 @@ def module_workdir() -> Iterator[Path]:
     shutil.rmtree(path, ignore_errors=True)
 
 
+def settle(daemon: Daemon, timeout_s: float) -> None:
+    """Release any latched emergency stop and wait until the robot is idle, so the next test starts clean."""
+    with daemon.client() as client:
+        client.reset()
+        deadline = time.monotonic() + timeout_s
+        while client.status()["state"] != "idle" and time.monotonic() < deadline:
+            time.sleep(0.1)
+
+
 def follow(client: Client, task: str, timeout: float = 300.0) -> list[dict[str, Any]]:
     """A followed task's events up to its terminal one, each checked against the schema."""
     client.settimeout(timeout)

@@ -17,7 +17,7 @@ from typing import Any
 import pytest
 
 from agent.client import RequestFailed
-from tests.daemon.conftest import NRTRANS, Daemon, check_frame, follow
+from tests.daemon.conftest import NRTRANS, Daemon, check_frame, follow, settle
 
 QUEUE_SIZE = 6
 
@@ -39,11 +39,7 @@ def daemon(module_workdir: Path) -> Iterator[Daemon]:
 def released(daemon: Daemon) -> Iterator[None]:
     """Each test starts with no latched emergency stop and an idle robot."""
     yield
-    with daemon.client() as client:
-        client.reset()
-        deadline = time.monotonic() + 60
-        while client.status()["state"] != "idle" and time.monotonic() < deadline:
-            time.sleep(0.1)
+    settle(daemon, 60)
 
 
 def _pose(event: dict[str, Any]) -> dict[str, float]:

@@ -19,7 +19,7 @@ import pytest
 
 from agent.client import Client, RequestFailed
 from agent.daemon.audit import read_records
-from tests.daemon.conftest import NRTRANS, Daemon, check_frame, follow
+from tests.daemon.conftest import NRTRANS, Daemon, check_frame, follow, settle
 
 MAX_CLIENTS = 3
 # Eight clauses: a translation that takes seconds, long enough to stop in the middle.
@@ -37,11 +37,7 @@ def daemon(module_workdir: Path) -> Iterator[Daemon]:
 def released(daemon: Daemon) -> Iterator[None]:
     """Each test starts with no latched emergency stop, an idle robot and no audit record left open."""
     yield
-    with daemon.client() as client:
-        client.reset()
-        deadline = time.monotonic() + 120
-        while client.status()["state"] != "idle" and time.monotonic() < deadline:
-            time.sleep(0.1)
+    settle(daemon, 120)
     assert _open_audit_records(daemon) == []
 
 
