@@ -57,11 +57,13 @@ def main() -> int:
                         help="two adapters, each run with the defaults on the suite, novel and dev sets")
     parser.add_argument("--sets", default="suite,novel,dev",
                         help=f"with --compare: which of {', '.join(SETS)} to run (default: all)")
-    parser.add_argument("--no-split", action="store_true", help="with --compare: whole tasks, no clause splitting")
+    parser.add_argument("--split", choices=("default", "on", "off"), default="default",
+                        help="with --compare: clause splitting (default: the translator's default)")
     args = parser.parse_args()
     if args.compare:
+        split = {"default": None, "on": True, "off": False}[args.split]
         return compare(args.compare, [s.strip() for s in args.sets.split(",") if s.strip()], args.every,
-                       not args.no_split, args.out or "bench/results/eval_adapters.json")
+                       split, args.out or "bench/results/eval_adapters.json")
     args.out = args.out or "bench/results/eval_side_by_side.json"
 
     profile = load_profile()
@@ -97,7 +99,7 @@ def main() -> int:
     return 0
 
 
-def compare(adapters: list[str], sets: list[str], every: int, split: bool, out: str) -> int:
+def compare(adapters: list[str], sets: list[str], every: int, split: bool | None, out: str) -> int:
     unknown = [name for name in sets if name not in SETS]
     if unknown:
         print(f"bench_eval: error: unknown set {', '.join(unknown)}; choose from {', '.join(SETS)}", file=sys.stderr)
@@ -120,7 +122,8 @@ def compare(adapters: list[str], sets: list[str], every: int, split: bool, out: 
             print(f"\n{name}, adapter {adapter}\n{render_table(table)}", file=sys.stderr, flush=True)
         translator.close()
     report = {
-        "note": f"grammar on, clause splitting {'on' if split else 'off'}, every {every}. task",
+        "note": f"grammar on, clause splitting {({None: 'default', True: 'on', False: 'off'})[split]}, "
+                f"every {every}. task",
         "adapters": adapters,
         "machine": f"{platform.machine()}, {os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f} at the end",
         "sets": results,

@@ -18,7 +18,7 @@ from rsl.profile import Profile
 
 # Bumped whenever the prompt text changes; the adapter card records it and the
 # runtime can refuse an adapter trained on another format.
-PROMPT_VERSION = 2
+PROMPT_VERSION = 3
 
 ADAPTER_FILE = "rsl-default-gemma3-270m-q4km.gguf"
 CARD_FILE = "rsl-default-gemma3-270m-q4km.json"
@@ -39,8 +39,10 @@ def convention_notes(normalized_task: str, profile: Profile) -> list[str]:
     """The profile's conventions for the vague phrases the task uses, one note each.
 
     A whole command ("look around") is noted with its program, an amount ("a
-    little") with its meaning. The adapter learns to follow the notes, so the
-    profile, not the training data alone, decides what a vague phrase does,
+    little") with its meaning, and so is a command about an object ("go get"),
+    whose example program names one object where the task may name another.
+    The adapter learns to follow the notes, so the profile, not the training
+    data alone, decides what a vague phrase does,
     and a phrase the data rarely shows on its own still gets its program.
     """
     notes = []
@@ -50,9 +52,19 @@ def convention_notes(normalized_task: str, profile: Profile) -> list[str]:
             continue  # the normalizer already writes it as a number ("a full circle" -> "6.2832 rad")
         if not phrase or not re.search(rf"\b{re.escape(phrase)}\b", normalized_task):
             continue
-        meaning = " ".join(convention.program.split()) if convention.whole_command else convention.meaning
+        as_program = convention.whole_command and not _names_object(convention.program, profile)
+        meaning = " ".join(convention.program.split()) if as_program else convention.meaning
         notes.append(f"{phrase} = {meaning}")
     return notes
+
+
+def _names_object(program: str, profile: Profile) -> bool:
+    """Whether a convention's program passes an object to a skill ("grasp cup;")."""
+    for statement in program.split(";"):
+        skill = profile.skill(statement.split()[0]) if statement.split() else None
+        if skill is not None and any(p.kind == "object" for p in skill.params):
+            return True
+    return False
 
 
 def adapter_prompt(normalized_task: str, profile: Profile) -> str:

@@ -32,7 +32,11 @@ def add_model_options(parser: argparse.ArgumentParser) -> None:
                         help="leave the worked examples out of the fixed, KV-cached prompt prefix "
                              "(then use --shots N to pick similar ones per clause)")
     parser.add_argument("--no-split", action="store_true",
-                        help="translate the task in one go instead of clause by clause")
+                        help="translate the task in one go instead of clause by clause (the default with the "
+                             "adapter)")
+    parser.add_argument("--split", action="store_true",
+                        help="split the task into clauses and translate them one by one (the default without "
+                             "the adapter)")
     parser.add_argument("--no-narrow", action="store_true",
                         help="do not narrow the grammar to the objects and numbers the task mentions")
     parser.add_argument("--profile", metavar="FILE", help="robot profile TOML (default: the built-in robot)")
@@ -50,7 +54,8 @@ def load_translator(args: argparse.Namespace) -> Any:
     profile = load_profile(args.profile)
     return Translator.load(profile, model=args.model, adapter=args.adapter, grammar=not args.no_grammar,
                            max_passes=args.max_passes, endpoint=args.endpoint, shots=args.shots,
-                           split_clauses=not args.no_split, narrow=not args.no_narrow,
+                           split_clauses=True if args.split else (False if args.no_split else None),
+                           narrow=not args.no_narrow,
                            prefix_shots=not args.no_prefix_shots)
 
 

@@ -131,13 +131,16 @@ class Translator:
     @classmethod
     def load(cls, profile: Profile, *, model: str | None = None, adapter: str | None = None,
              grammar: bool = True, max_passes: int = 3, endpoint: str | None = None, shots: int | None = None,
-             split_clauses: bool = True, narrow: bool = True, prefix_shots: bool = True) -> Translator:
+             split_clauses: bool | None = None, narrow: bool = True, prefix_shots: bool = True) -> Translator:
         """Load the model (or connect to `endpoint`).
 
         `adapter`: None for the shipped adapter when it fits the model and
         profile, "none" for no adapter, "default" for the shipped adapter of
         the embedded default model, or the path of a LoRA GGUF.
-        `shots`: None picks the mode's default.
+        `shots`, `split_clauses`: None picks the mode's default. The adapter
+        reads the whole task (it was trained on whole tasks, and splitting
+        cut vocatives, corrections and negations into steps of their own);
+        the base model gets one clause at a time.
         """
         if max_passes < 1:
             raise ValueError("max_passes must be at least 1")
@@ -158,7 +161,8 @@ class Translator:
         use_adapter = lora is not None
         options = Options(grammar=grammar, max_passes=max_passes,
                           shots=(0 if use_adapter else DEFAULT_SHOTS) if shots is None else shots,
-                          split_clauses=split_clauses, narrow=narrow, narrow_skills=not use_adapter,
+                          split_clauses=not use_adapter if split_clauses is None else split_clauses,
+                          narrow=narrow, narrow_skills=not use_adapter,
                           adapter_prompt=use_adapter, prefix_shots=prefix_shots and not use_adapter,
                           refuse_unclear=use_adapter, refusal=use_adapter)
         return cls(profile, engine, name, options)

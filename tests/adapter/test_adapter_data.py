@@ -43,7 +43,7 @@ def test_every_skill_and_group_is_covered(pairs, profile: Profile) -> None:
             if pair.group != "refuse"}
     assert used == set(profile.keywords)
     assert {p.group for p in pairs} == {"simple", "ambiguous", "multi-step", "complex", "correction",
-                                        "negation", "repetition", "refuse"}
+                                        "negation", "activity", "repetition", "refuse"}
 
 
 def test_training_input_is_the_normalized_task(pairs) -> None:
@@ -176,22 +176,8 @@ def test_a_self_correction_keeps_only_what_was_settled_on(profile: Profile) -> N
             assert clause.commands[0].number() == float(numbers[-1]), clause
 
 
-# A whole-activity convention about an object, as docs/adapter.md proposes for the default profile.
-GO_GET = """
-[[conventions]]
-phrase = "go get"
-meaning = "approach the object, grasp it, then come back to the start (goto 0, 0)"
-task = "go get the cup"
-program = "approach cup; grasp cup; goto 0, 0;"
-
-"""
-
-
-def test_an_activity_convention_is_varied_in_its_object() -> None:
-    from rsl.profile import default_profile_path
-
-    with_activity = parse_profile(default_profile_path().read_text(encoding="utf-8") + GO_GET)
-    generator = Generator(with_activity, seed=2)
+def test_an_activity_convention_is_varied_in_its_object(profile: Profile) -> None:
+    generator = Generator(profile, seed=2)
     seen = set()
     for _ in range(60):
         clause = generator.activity()
@@ -209,3 +195,9 @@ def test_a_negated_skill_is_not_in_the_program(profile: Profile) -> None:
         clause = generator.negated()
         if clause.text.startswith("don't move, just "):
             assert all(c.skill not in ("forward", "backward", "approach", "goto") for c in clause.commands)
+
+
+def test_an_object_convention_is_noted_by_its_meaning(profile: Profile) -> None:
+    prompt = adapter_prompt(normalize_task("go get the mug"), profile)
+    assert "Note: go get = approach the object, grasp it" in prompt
+    assert "cup" not in prompt
