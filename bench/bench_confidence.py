@@ -51,13 +51,15 @@ def main() -> int:
     parser.add_argument("--suite", metavar="FILE", help="suite file (default: the evaluation suite)")
     parser.add_argument("--every", type=int, default=1, metavar="K", help="only every K-th task (default: all)")
     parser.add_argument("--out", default="bench/results/confidence_suite.json")
+    parser.add_argument("--adapter", default="default", metavar="PATH",
+                        help="adapter GGUF to measure (default: the shipped one)")
     parser.add_argument("--per-task", action="store_true",
                         help="also write each task's outcome (only for sets that may be looked at)")
     args = parser.parse_args()
 
     profile = load_profile()
     tasks = load_suite(args.suite, profile)[:: max(1, args.every)]
-    translator = Translator.load(profile, adapter="default")
+    translator = Translator.load(profile, adapter=args.adapter)
     rows: list[dict[str, Any]] = []
     checks_ms: list[float] = []
     started = time.monotonic()
@@ -89,6 +91,7 @@ def main() -> int:
                       "accuracy": sum(r["right"] for r in kept) / len(kept) if kept else None})
     summary: dict[str, Any] = {
         "suite": str(args.suite or suite_path()),
+        "adapter": args.adapter,
         "items": items, "tasks": len(real), "non_tasks": len(chat),
         "unsure_below": UNSURE_BELOW,
         "wrong_runs_unasked": sum(1 for r in wrong if not r["confirm"]) / items,
@@ -102,6 +105,9 @@ def main() -> int:
                                        if chat else None),
         "tasks_refused_e201": sum(1 for r in real if r["refused"]) / len(real) if real else None,
         "tasks_right": sum(1 for r in real if r["right"]) / len(real) if real else None,
+        "right_by_group": {group: sum(r["right"] for r in rows if r["group"] == group)
+                           / sum(1 for r in rows if r["group"] == group)
+                           for group in dict.fromkeys(r["group"] for r in rows)},
         "auroc": auroc([r["confidence"] for r in right], [r["confidence"] for r in wrong]),
         "coverage_curve": curve,
         "checks_ms_p50": percentile(checks_ms, 0.5), "checks_ms_p95": percentile(checks_ms, 0.95),

@@ -7,15 +7,18 @@ wrong. Writes bench/results/eval_side_by_side.json.
 
     python bench/bench_eval.py [--adapter PATH|default] [--suite FILE] [--every K] [--out FILE]
 
-With --compare OLD NEW it instead runs the default configuration (adapter,
-grammar) with each of two adapters on the evaluation suite, the novel tasks
-and the fresh development set side by side, and writes
-bench/results/eval_adapters.json. The fresh set's per-task results are left
-out of the file: only its per-group table may be looked at. An adapter
+With --compare ADAPTER ... it instead runs the default configuration
+(adapter, grammar) with each adapter in turn (old against new, or a training
+run's checkpoints for a learning curve) on the evaluation suite, the novel
+tasks and the fresh development set, and writes
+bench/results/eval_adapters.json. Only the suite's and the novel set's
+per-task results are kept: of the fresh sets, and of any other suite file
+named in --sets, only the per-group table may be looked at. An adapter
 trained on an older prompt format is refused by the runtime; pass a copy of
 its GGUF without the card to compare it anyway.
 
     python bench/bench_eval.py --compare /tmp/old.gguf models/adapters/rsl-default-gemma3-270m-q4km.gguf
+    python bench/bench_eval.py --compare run.step200.gguf run.step400.gguf run.gguf --sets suite,dev
 """
 
 from __future__ import annotations
@@ -34,9 +37,11 @@ from agent.evalsuite.runner import render_table, run_suite, summarize
 from agent.translate import Translator
 from rsl.profile import load_profile
 
-SETS = {"suite": None, "novel": "bench/novel_tasks.toml", "dev": "bench/fresh/dev.toml"}
-# Sets whose tasks nobody may read: only their per-group table is kept.
-FRESH = ("bench/fresh/",)
+SETS = {"suite": None, "novel": "bench/novel_tasks.toml", "dev": "bench/fresh/dev.toml",
+        "final": "bench/fresh/final.toml"}
+# Only these sets' per-task results may be read; of any other (the fresh sets, a held-out file) only the
+# per-group table is kept.
+READABLE = ("suite", "novel")
 
 CONFIGURATIONS = (
     ("base, shots, no grammar", {"adapter": "none", "grammar": False}),
@@ -53,10 +58,12 @@ def main() -> int:
     parser.add_argument("--every", type=int, default=1, metavar="K", help="only every K-th task (default: all)")
     parser.add_argument("--out", help="JSON report (default: bench/results/eval_side_by_side.json, or "
                                       "bench/results/eval_adapters.json with --compare)")
-    parser.add_argument("--compare", nargs=2, metavar=("OLD", "NEW"),
-                        help="two adapters, each run with the defaults on the suite, novel and dev sets")
+    parser.add_argument("--compare", nargs="+", metavar="ADAPTER",
+                        help="two or more adapters (old, new, or a training run's checkpoints for a learning "
+                             "curve), each run with the defaults on the suite, novel and dev sets")
     parser.add_argument("--sets", default="suite,novel,dev",
-                        help=f"with --compare: which of {', '.join(SETS)} to run (default: all)")
+                        help=f"with --compare: which of {', '.join(SETS)} to run, or a suite file's path, whose "
+                             "per-task results are not kept (default: suite,novel,dev)")
     parser.add_argument("--split", choices=("default", "on", "off"), default="default",
                         help="with --compare: clause splitting (default: the translator's default)")
     args = parser.parse_args()
@@ -100,23 +107,24 @@ def main() -> int:
 
 
 def compare(adapters: list[str], sets: list[str], every: int, split: bool | None, out: str) -> int:
-    unknown = [name for name in sets if name not in SETS]
+    unknown = [name for name in sets if name not in SETS and not Path(name).is_file()]
     if unknown:
-        print(f"bench_eval: error: unknown set {', '.join(unknown)}; choose from {', '.join(SETS)}", file=sys.stderr)
+        print(f"bench_eval: error: unknown set {', '.join(unknown)}; choose from {', '.join(SETS)} or name a "
+              "suite file", file=sys.stderr)
         return 2
     profile = load_profile()
     results: dict[str, dict[str, Any]] = {}
     for adapter in adapters:
         translator = Translator.load(profile, adapter=adapter, split_clauses=split)
         for name in sets:
-            path = SETS[name]
+            path = SETS.get(name, name)
             tasks = list(load_suite(path, profile=profile))[:: max(1, every)]
             started = time.perf_counter()
             outcomes = run_suite(translator, tasks, profile)
             table = summarize(outcomes)
             entry: dict[str, Any] = {"suite": path or "agent/evalsuite/suite.toml", "tasks": len(tasks),
                                      "wall_s": round(time.perf_counter() - started, 1), "table": table}
-            if not (path or "").startswith(FRESH):
+            if name in READABLE:
                 entry["misses"] = [o.to_dict() for o in outcomes if not o.accepted]
             results.setdefault(name, {})[adapter] = entry
             print(f"\n{name}, adapter {adapter}\n{render_table(table)}", file=sys.stderr, flush=True)

@@ -206,6 +206,12 @@ NOT_TASKS = (
     "how many {o}s are there", "what is in front of you", "which way is left", "how fast can you go",
     "how big is this room", "who made you", "do you like the {o}", "is it raining", "what day is it",
     "how long will that take", "did you hear that", "what's two plus two", "are you done",
+    "did you grab the {o}", "where did you put the {o}", "is the {o} still there", "have you seen the {o}",
+    "how heavy can you lift", "what is that", "how old are you", "are you a robot", "can robots dream",
+    "what's the plan", "how did you do that", "why are you turning", "where did you go", "what's next",
+    # remarks about the robot's own moves are not a request for one
+    "you moved too far", "you turned the wrong way", "that was a nice turn", "you drove very well",
+    "i saw you grab the {o}", "you dropped the {o}", "the {o} is broken", "i bought a new {o}",
     # chit-chat and statements
     "nice job", "good job robot", "well done", "good robot", "i'm tired", "it's cold in here",
     "the {o} is on the table", "i dropped the {o}", "that was great", "you're doing fine", "interesting",
@@ -783,7 +789,7 @@ class Generator:
     def task(self) -> tuple[str, list[Command], str]:
         """One raw task, its commands and its group ("refuse" when it has no program)."""
         r = self.rng.random()
-        if r < 0.12:
+        if r < 0.15:
             return self._surface(self.not_a_task()), [], "refuse"
         if r < 0.3:
             text, commands, group = self._base_task()
@@ -826,15 +832,15 @@ class Generator:
     def _base_task(self) -> tuple[str, list[Command], str]:
         """The plain task shapes: one step, vague amounts, conventions, sequences, fetching, repetition."""
         r = self.rng.random()
-        if r < 0.3:
+        if r < 0.28:
             clause = self.simple()
             group = "simple"
             text, commands = clause.text, list(clause.commands)
-        elif r < 0.4 and self.by_motion:
+        elif r < 0.43 and self.by_motion:
             role = self._motion_role()
             clause = self.motion(role, "vague" if self.rng.random() < 0.6 else "bare")
             text, commands, group = clause.text, list(clause.commands), "ambiguous"
-        elif r < 0.47 and self.whole:
+        elif r < 0.5 and self.whole:
             clause = self.whole_convention() or self.simple()
             text, commands, group = clause.text, list(clause.commands), "ambiguous"
         elif r < 0.72:
@@ -842,7 +848,7 @@ class Generator:
             text = self._join([c.text for c in clauses])
             commands = [c for clause in clauses for c in clause.commands]
             group = "multi-step"
-        elif r < 0.85:
+        elif r < 0.82:
             clauses = self.fetch() or [self.simple(), self.simple()]
             if self.rng.random() < 0.3:
                 clauses.insert(0, self.simple())
