@@ -122,6 +122,14 @@ def test_words_after_cuts_by_time_and_by_text() -> None:
     assert words_after({"text": "[noise] turn left"}, None, ["robot"]) == "turn left"
 
 
+def test_a_word_that_ends_with_the_wake_word_is_not_part_of_the_task() -> None:
+    # A lone "로봇" that the task recogniser heard as the number word "오", ending where the wake word ended:
+    # its middle is within the slack of the cut, its end is not after it.
+    assert words_after({"result": [{"word": "오", "start": 0.72, "end": 0.87}], "text": "오"}, 0.87, ["로봇"]) == ""
+    said_after = {"result": [{"word": "오", "start": 0.9, "end": 1.05}, {"word": "미터", "start": 1.05, "end": 1.4}]}
+    assert words_after(said_after, 0.87, ["로봇"]) == "오 미터"
+
+
 def test_trim_leading_quiet_keeps_half_a_second_of_lead_in() -> None:
     quiet = np.zeros(1600, dtype=np.int16).tobytes()
     loud = (np.ones(1600) * 5000).astype(np.int16).tobytes()
