@@ -130,6 +130,12 @@ class Skill:
     say: str = ""
     # A skill run first on this skill's object when the object is out of the arm's reach (`approach`).
     out_of_reach: str | None = None
+    # Words a speaker of another language says for the skill, per language code (`ko`), that the
+    # recogniser is biased toward; English words are the keyword and aliases.
+    words: tuple[tuple[str, tuple[str, ...]], ...] = ()
+
+    def words_in(self, language: str) -> tuple[str, ...]:
+        return dict(self.words).get(language, ())
 
     @property
     def primitive(self) -> Primitive | None:
@@ -389,13 +395,20 @@ def _skill(raw: dict[str, Any], index: int, workspace: dict[str, tuple[float, fl
                             min=None if low is None else float(low),
                             max=None if high is None else float(high), axis=axis))
     aliases = tuple(str(a).lower() for a in raw.get("aliases", []))
+    words = raw.get("words", {})
+    if not isinstance(words, dict) or not all(
+            isinstance(spoken, list) and spoken and all(isinstance(w, str) and w.strip() for w in spoken)
+            for spoken in words.values()):
+        raise fail(f"skill `{word}`: `words` must map a language code to the words said for the skill, "
+                   f"e.g. words = {{ ko = [\"앞으로\"] }}")
     binding = None
     if "binding" in raw:
         binding = _binding(raw["binding"], word, tuple(params), lambda m: fail(f"skill `{word}`: binding {m}"))
     return Skill(keyword=word, description=str(raw.get("description", "")),
                  example=str(raw.get("example", f"{word};")), params=tuple(params), aliases=aliases,
                  opposite=raw.get("opposite"), binding=binding,
-                 say=str(raw.get("say", "")), out_of_reach=raw.get("out_of_reach"))
+                 say=str(raw.get("say", "")), out_of_reach=raw.get("out_of_reach"),
+                 words=tuple((language, tuple(spoken)) for language, spoken in words.items()))
 
 
 def _binding(raw: Any, word: str, params: tuple[Param, ...], fail: Any) -> Binding:

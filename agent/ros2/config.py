@@ -21,9 +21,11 @@ class RosConfig:
     head_trajectory: str = "/head_controller/joint_trajectory"
     gripper_trajectory: str = "/gripper_controller/joint_trajectory"
     goal_pose: str = "/goal_pose"
-    perceive_service: str = "/perceive"
+    # The Trigger services of the perceive_objects and grasp_object primitives, named after them
+    # unless the profile names them.
+    perceive_service: str = "/perceive_objects"
     objects_topic: str = "/objects"
-    grasp_service: str = "/grasp"
+    grasp_service: str = "/grasp_object"
     head_pan_joint: str = "head_pan_joint"
     head_tilt_joint: str = "head_tilt_joint"
     gripper_joint: str = "gripper_joint"

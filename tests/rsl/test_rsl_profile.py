@@ -69,3 +69,15 @@ def test_missing_profile_file_is_a_clear_error(tmp_path):
 def test_not_toml_is_a_clear_error():
     with pytest.raises(ProfileError, match="not valid TOML"):
         parse_profile("[[skills]\n", source="bad.toml")
+
+
+def test_words_in_another_language_come_from_the_profile_and_leave_the_digest(profile):
+    forward = profile.skill("forward")
+    assert forward is not None and forward.words_in("ko") == ("앞으로", "전진")
+    assert forward.words_in("en") == ()
+    text = default_profile_path().read_text()
+    without = parse_profile(text.replace('words = { ko = ["앞으로", "전진"] }\n', ""), source="plain.toml")
+    assert without.digest == profile.digest, "words are how a skill is heard, not what an adapter learned"
+    with pytest.raises(ProfileError, match="`words` must map a language code"):
+        parse_profile(text.replace('words = { ko = ["앞으로", "전진"] }', 'words = { ko = "앞으로" }'),
+                      source="broken.toml")
