@@ -8,7 +8,7 @@ the cup", "driving forward") is not code that knows the keyword. Docstrings
 are documentation and are not searched. The keywords come from the default
 profile itself, not from a copy here.
 
-`pytest tests/profile -s` prints what was searched.
+`pytest tests/layers -s` prints what was searched.
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from rsl.profile import load_profile
-from tests.profile.modules import ROOT, runtime_modules
+from tests.layers.modules import ROOT, runtime_modules
 
 # (module path, the exact string) -> why it may stay. Keep it short.
 ALLOWED: dict[tuple[str, str], str] = {}
