@@ -1,0 +1,1 @@
+"""Settings read through agent/settings.py."""
