@@ -1,7 +1,7 @@
 """The daemon's settings: one TOML file, every setting with a default.
 
 The dataclasses below are the single source of truth: `load_config` reads
-them (through agent/settings.py, which checks each value against its field's
+them (through rsl/settings.py, which checks each value against its field's
 type and metadata), `render_markdown` writes docs/config.md from them and
 `render_toml` writes a commented example file, so the documentation cannot
 drift from the code.
@@ -16,7 +16,7 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any, get_type_hints
 
-from agent.settings import check_value, read_settings
+from rsl.settings import check_value, read_settings
 
 
 class ConfigError(ValueError):

@@ -2,7 +2,7 @@
 
 The `[ros]` table of the robot profile is the one place a robot's topic,
 service and joint names live; this module fills in defaults for the keys a
-profile leaves out and, through agent/settings.py, rejects unknown keys and
+profile leaves out and, through rsl/settings.py, rejects unknown keys and
 values of the wrong type or range with a clear message.
 """
 
@@ -11,8 +11,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from agent.settings import read_settings, setting
 from rsl.profile import Profile, ProfileError
+from rsl.settings import read_settings, setting
 
 
 def _name(default: str, doc: str) -> Any:

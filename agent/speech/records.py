@@ -6,7 +6,7 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
-from agent.settings import read_settings, setting
+from rsl.settings import read_settings, setting
 
 # barge_in: the stop listener heard a stop word while the robot moved; the text is only ever that word.
 TranscriptSource = Literal["wake_word", "push_to_talk", "file", "barge_in"]

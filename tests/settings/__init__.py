@@ -1,1 +1,1 @@
-"""Settings read through agent/settings.py."""
+"""Settings read through rsl/settings.py."""

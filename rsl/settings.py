@@ -5,8 +5,9 @@ check: the type (from the annotation) and, in the field's metadata (`setting`),
 the documentation, bounds and allowed values. `read_settings` rejects an
 unknown key, a value of the wrong type or out of bounds with the same kind of
 message everywhere: where (file and key), what was wrong, and what to do.
-The daemon's config file, the `[speech.options]` table and a profile's `[ros]`
-table are read this way.
+A robot profile's `[motion]`, `[limits]` and `[ros]` tables, the daemon's
+config file and its `[speech.options]` table are read this way. It lives at the
+bottom, beside the profile, so that everything above can use it.
 """
 
 from __future__ import annotations
