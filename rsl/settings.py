@@ -22,11 +22,16 @@ T = TypeVar("T")
 
 def setting(default: Any = dataclasses.MISSING, *, doc: str, default_factory: Any = dataclasses.MISSING,
             min: float | None = None, max: float | None = None, above: float | None = None,
-            choices: tuple[str, ...] = (), octal: bool = False, nonempty: bool = False) -> Any:
-    """A dataclass field that is a setting: `min`/`max` bound it inclusively, `above` exclusively;
-    `octal` wants a string of octal digits, `nonempty` a string or list that is not empty."""
+            choices: tuple[str, ...] = (), octal: bool = False, nonempty: bool = False,
+            length: int | None = None) -> Any:
+    """A dataclass field that is a setting; without a default it must be given.
+
+    `min`/`max` bound a number (each number of a list) inclusively, `above` exclusively; `octal`
+    wants a string of octal digits, `nonempty` a string or list that is not empty, `length` a list
+    of that many items.
+    """
     rules = {"min": min, "max": max, "above": above, "choices": choices or None, "octal": octal or None,
-             "nonempty": nonempty or None}
+             "nonempty": nonempty or None, "length": length}
     metadata = {"doc": doc, **{k: v for k, v in rules.items() if v is not None}}
     if default_factory is not dataclasses.MISSING:
         return dataclasses.field(default_factory=default_factory, metadata=metadata)
@@ -35,7 +40,8 @@ def setting(default: Any = dataclasses.MISSING, *, doc: str, default_factory: An
 
 def read_settings(cls: type[T], data: Any, *, error: type[Exception], source: str = "", prefix: str = "",
                   docs: str = "") -> T:
-    """`cls` built from the table `data`; a nested dataclass field is read from a nested table.
+    """`cls` built from the table `data`; a nested dataclass field is read from a nested table, and a
+    field typed `tuple[SomeDataclass, ...]` from a list of tables.
 
     `prefix` names the table in messages ("api."), `docs` where its settings are described.
     """
@@ -49,12 +55,23 @@ def read_settings(cls: type[T], data: Any, *, error: type[Exception], source: st
         also = f"; see {docs}" if docs else ""
         raise error(f"{where}unknown setting {prefix}{unknown[0]}\n"
                     f"  = help: the settings here are {', '.join(prefix + k for k in known)}{also}")
+    missing = [name for name, f in known.items() if name not in data
+               and f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING]
+    if missing:
+        raise error(f"{where}{prefix}{missing[0]} must be given: {known[missing[0]].metadata.get('doc', '')}")
     values: dict[str, Any] = {}
     for name, value in data.items():
         hint = hints[name]
+        item = get_args(hint)[0] if get_origin(hint) is tuple else None
         if dataclasses.is_dataclass(hint):
             values[name] = read_settings(hint, value, error=error, source=source,  # type: ignore[arg-type]
                                          prefix=f"{prefix}{name}.", docs=docs)
+        elif dataclasses.is_dataclass(item):
+            if not isinstance(value, list):
+                raise error(f"{where}{prefix}{name} must be a list of tables ([[{prefix}{name}]]), not {value!r}")
+            values[name] = tuple(read_settings(item, entry, error=error, source=source,  # type: ignore[arg-type]
+                                               prefix=f"{prefix}{name}[{index}].", docs=docs)
+                                 for index, entry in enumerate(value, start=1))
         else:
             values[name] = check_value(f"{prefix}{name}", hint, value, known[name].metadata, error=error,
                                        source=source)
@@ -70,12 +87,17 @@ def check_value(key: str, hint: Any, value: Any, rules: Mapping[str, Any], *, er
         return error(f"{where}{key} must be {expected}, not {value!r}")
 
     result = _typed(hint, value, wrong)
-    if isinstance(result, int | float) and not isinstance(result, bool):
-        for rule, fails, says in (("min", lambda b: result < b, "below the minimum"),
-                                  ("max", lambda b: result > b, "above the maximum"),
-                                  ("above", lambda b: result <= b, "not above")):
+    if "length" in rules and len(result) != rules["length"]:
+        raise error(f"{where}{key} must have {rules['length']} items, not {value!r}")
+    for number in result if isinstance(result, tuple) else (result,):
+        if not isinstance(number, int | float) or isinstance(number, bool):
+            continue
+        for rule, fails, says in (("min", lambda b, n=number: n < b, "below the minimum"),
+                                  ("max", lambda b, n=number: n > b, "above the maximum"),
+                                  ("above", lambda b, n=number: n <= b, "not above")):
             if rule in rules and fails(rules[rule]):
-                raise error(f"{where}{key} = {value!r} is {says} {rules[rule]}")
+                raise error(f"{where}{key} = {value!r}" + (f": {number!r}" if number is not result else "")
+                            + f" is {says} {rules[rule]}")
     if rules.get("nonempty") and not result:
         raise error(f"{where}{key} must not be empty")
     if rules.get("octal"):
