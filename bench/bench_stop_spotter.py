@@ -122,8 +122,9 @@ def main() -> None:
     wake = lexicon.wake_words
     vocabulary = model.vocabulary(load_profile(), args.language, (), wake)
     stops = [w for w in lexicon.stop_words if model.find_word(w) >= 0]
-    motion_words = sorted({w for keyword in ("forward", "backward", "turnleft", "turnright", "goto")
-                           for w in lexicon.skill_words.get(keyword, (keyword,))})
+    motion_words = sorted({w for skill in load_profile().skills
+                           if skill.primitive is not None and skill.primitive.name in ("drive", "turn", "navigate")
+                           for w in skill.words_in(args.language) or (skill.keyword,)})
     stop_texts = [*stops, *(f"{w} {w}" for w in stops), *(f"{wake[0]} {w}" for w in stops)]
     other_texts = [*COMMANDS[args.language], *motion_words, *OTHER_SPEECH[args.language]]
     voice = VOICES[args.language]

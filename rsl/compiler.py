@@ -267,15 +267,19 @@ class _Compiler:
         close = difflib.get_close_matches(name, known, n=1, cutoff=0.6)
         if close:
             return f"`{name}` is not an object this robot knows; did you mean `{close[0]}`?"
-        listed = ", ".join(f"`{k}`" for k in known) or "none yet (use `perceive;` first)"
+        perceive = self.profile.bound_to("perceive_objects")
+        listed = ", ".join(f"`{k}`" for k in known) or (
+            f"none yet (use `{perceive.signature}` first)" if perceive is not None else "none")
         return f"`{name}` is not an object this robot knows; the known objects are {listed}"
 
     def command_list(self) -> str:
         return ", ".join(f"`{k}`" for k in self.profile.keywords)
 
-    @staticmethod
-    def example(statement: _Statement) -> str:
-        return statement.skill.example if statement.skill else "goto 1, 2;"
+    def example(self, statement: _Statement) -> str:
+        if statement.skill is not None:
+            return statement.skill.example
+        # An unknown word: show a statement with arguments, the comma's place.
+        return max(self.profile.skills, key=lambda s: len(s.params)).example
 
     @staticmethod
     def describe_param(param: Param) -> str:

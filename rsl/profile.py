@@ -19,6 +19,8 @@ from importlib import resources
 from pathlib import Path
 from typing import Any, Literal
 
+from rsl.settings import read_settings, setting
+
 IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 SKILL_KEYWORD = re.compile(r"[a-z][a-z0-9_]*\Z")
 _AMOUNT = re.compile(r"\d\s*[a-z]+\b")
@@ -130,6 +132,12 @@ class Skill:
     say: str = ""
     # A skill run first on this skill's object when the object is out of the arm's reach (`approach`).
     out_of_reach: str | None = None
+    # Words a speaker of another language says for the skill, per language code (`ko`), that the
+    # recogniser is biased toward; English words are the keyword and aliases.
+    words: tuple[tuple[str, tuple[str, ...]], ...] = ()
+
+    def words_in(self, language: str) -> tuple[str, ...]:
+        return dict(self.words).get(language, ())
 
     @property
     def primitive(self) -> Primitive | None:
@@ -177,15 +185,24 @@ class Inability:
 
 @dataclass(frozen=True)
 class Motion:
-    max_linear_speed: float = 0.5
-    max_angular_speed: float = 1.0
-    max_linear_accel: float = 1.0
-    max_angular_accel: float = 2.0
-    max_head_speed: float = 1.5
-    reach: float = 0.8
-    standoff: float = 0.5
-    timeout_margin: float = 5.0
-    width: float = 0.4  # m, across the base: the corridor a straight drive sweeps
+    """The profile's `[motion]` table."""
+
+    max_linear_speed: float = setting(0.5, above=0.0, doc="m/s")
+    max_angular_speed: float = setting(1.0, above=0.0, doc="rad/s")
+    max_linear_accel: float = setting(1.0, above=0.0, doc="m/s^2")
+    max_angular_accel: float = setting(2.0, above=0.0, doc="rad/s^2")
+    max_head_speed: float = setting(1.5, above=0.0, doc="rad/s")
+    reach: float = setting(0.8, above=0.0, doc="m, from the base centre to the farthest graspable point")
+    standoff: float = setting(0.5, above=0.0, doc="m, where approaching an object stops in front of it")
+    timeout_margin: float = setting(5.0, min=0.0, doc="s, added to every step's time budget")
+    width: float = setting(0.4, above=0.0, doc="m, across the base: the corridor a straight drive sweeps")
+
+
+@dataclass(frozen=True)
+class _Limits:
+    """The profile's `[limits]` table."""
+
+    max_statements: int = setting(64, min=1, doc="a longer program is rejected before it reaches the robot")
 
 
 @dataclass(frozen=True)
@@ -290,12 +307,8 @@ def _build(data: dict[str, Any], source: str) -> Profile:
             if alias in seen:
                 raise fail(f"alias `{alias}` of `{skill.keyword}` is itself a skill keyword")
 
-    motion_fields = Motion.__dataclass_fields__
-    raw_motion = data.get("motion", {})
-    unknown = set(raw_motion) - set(motion_fields)
-    if unknown:
-        raise fail(f"unknown [motion] settings: {', '.join(sorted(unknown))}")
-    motion = Motion(**{k: float(v) for k, v in raw_motion.items()})
+    motion = read_settings(Motion, data.get("motion", {}), error=ProfileError, source=source, prefix="motion.",
+                           docs="docs/skills.md")
 
     conventions = tuple(
         Convention(phrase=str(c["phrase"]), meaning=str(c["meaning"]),
@@ -313,10 +326,8 @@ def _build(data: dict[str, Any], source: str) -> Profile:
                 if phrase.lower() in (skill.keyword, *skill.aliases):
                     raise fail(f"[[cannot]] phrase {phrase!r} is a word for the skill `{skill.keyword}`")
         cannot.append(Inability(what=what, phrases=tuple(p.strip().lower() for p in phrases)))
-    limits = data.get("limits", {})
-    max_statements = int(limits.get("max_statements", 64))
-    if max_statements < 1:
-        raise fail("limits.max_statements must be at least 1")
+    max_statements = read_settings(_Limits, data.get("limits", {}), error=ProfileError, source=source,
+                                   prefix="limits.", docs="docs/skills.md").max_statements
 
     return Profile(
         name=str(robot.get("name", Path(source).stem)),
@@ -389,13 +400,20 @@ def _skill(raw: dict[str, Any], index: int, workspace: dict[str, tuple[float, fl
                             min=None if low is None else float(low),
                             max=None if high is None else float(high), axis=axis))
     aliases = tuple(str(a).lower() for a in raw.get("aliases", []))
+    words = raw.get("words", {})
+    if not isinstance(words, dict) or not all(
+            isinstance(spoken, list) and spoken and all(isinstance(w, str) and w.strip() for w in spoken)
+            for spoken in words.values()):
+        raise fail(f"skill `{word}`: `words` must map a language code to the words said for the skill, "
+                   f"e.g. words = {{ ko = [\"앞으로\"] }}")
     binding = None
     if "binding" in raw:
         binding = _binding(raw["binding"], word, tuple(params), lambda m: fail(f"skill `{word}`: binding {m}"))
     return Skill(keyword=word, description=str(raw.get("description", "")),
                  example=str(raw.get("example", f"{word};")), params=tuple(params), aliases=aliases,
                  opposite=raw.get("opposite"), binding=binding,
-                 say=str(raw.get("say", "")), out_of_reach=raw.get("out_of_reach"))
+                 say=str(raw.get("say", "")), out_of_reach=raw.get("out_of_reach"),
+                 words=tuple((language, tuple(spoken)) for language, spoken in words.items()))
 
 
 def _binding(raw: Any, word: str, params: tuple[Param, ...], fail: Any) -> Binding:

@@ -25,7 +25,7 @@ def register(subparsers: Any) -> None:
         epilog="Examples:\n"
                "  nrtrans run-program task.rsl --record runs/one --gif\n"
                "  nrtrans run-program task.rsl --backend ros2 --dry-run --json\n"
-               "  echo 'perceive; approach table; grasp cup;' | nrtrans run-program -",
+               "  nrtrans translate \"pick up the cup\" --objects cup,table | nrtrans run-program -",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("program", metavar="FILE", help="the RSL program; `-` reads standard input")
     parser.add_argument("--backend", choices=("sim", "ros2"), default="sim",

@@ -1,9 +1,10 @@
 """The daemon's settings: one TOML file, every setting with a default.
 
 The dataclasses below are the single source of truth: `load_config` reads
-them, `render_markdown` writes docs/config.md from them and `render_toml`
-writes a commented example file, so the documentation cannot drift from
-the code.
+them (through rsl/settings.py, which checks each value against its field's
+type and metadata), `render_markdown` writes docs/config.md from them and
+`render_toml` writes a commented example file, so the documentation cannot
+drift from the code.
 """
 
 from __future__ import annotations
@@ -14,6 +15,8 @@ import tomllib
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any, get_type_hints
+
+from rsl.settings import check_value, read_settings
 
 
 class ConfigError(ValueError):
@@ -33,7 +36,9 @@ class ApiConfig:
             "`$XDG_RUNTIME_DIR/nrtrans/nrtrans.sock`, else `/run/nrtrans/nrtrans.sock`."
         ),
     )
-    socket_mode: str = field(default="0660", metadata=_doc("Permission bits of the socket file, as an octal string."))
+    socket_mode: str = field(
+        default="0660", metadata=_doc("Permission bits of the socket file, as an octal string.", octal=True)
+    )
     allowed_uids: tuple[int, ...] = field(
         default=(),
         metadata=_doc(
@@ -243,7 +248,7 @@ class Config:
         if state_dir:
             config = dataclasses.replace(config, state_dir=state_dir)
         if backend:
-            _check_choice("robot.backend", backend, _meta(RobotConfig, "backend"))
+            check_value("robot.backend", str, backend, _meta(RobotConfig, "backend"), error=ConfigError)
             config = dataclasses.replace(config, robot=dataclasses.replace(config.robot, backend=backend))
         return config
 
@@ -281,83 +286,11 @@ def parse_config(text: str, source: str = "<config>") -> Config:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{source}: not valid TOML: {exc}") from exc
-    config = _build(Config, data, source, prefix="")
-    assert isinstance(config, Config)
-    return config
+    return read_settings(Config, data, error=ConfigError, source=source, docs="docs/config.md")
 
 
 def _meta(cls: type, name: str) -> dict[str, Any]:
     return dict(next(f for f in fields(cls) if f.name == name).metadata)
-
-
-def _check_choice(key: str, value: Any, meta: dict[str, Any]) -> None:
-    choices = meta.get("choices")
-    if choices and value not in choices:
-        raise ConfigError(f"{key} = {value!r} is not one of {', '.join(map(repr, choices))}")
-
-
-def _build(cls: type, data: Any, source: str, prefix: str) -> Any:
-    where = prefix.rstrip(".") or "the top level"
-    if not isinstance(data, dict):
-        raise ConfigError(f"{source}: {where} must be a table")
-    hints = get_type_hints(cls)
-    known = {f.name: f for f in fields(cls)}
-    unknown = sorted(set(data) - set(known))
-    if unknown:
-        raise ConfigError(
-            f"{source}: unknown setting {prefix}{unknown[0]}\n"
-            f"  = help: the settings here are {', '.join(prefix + k for k in known)}; see docs/config.md"
-        )
-    values: dict[str, Any] = {}
-    for name, value in data.items():
-        key = prefix + name
-        hint = hints[name]
-        if dataclasses.is_dataclass(hint):
-            values[name] = _build(hint, value, source, key + ".")  # type: ignore[arg-type]
-            continue
-        values[name] = _coerce(key, hint, value, known[name].metadata, source)
-    return cls(**values)
-
-
-def _coerce(key: str, hint: Any, value: Any, meta: Any, source: str) -> Any:
-    def wrong(expected: str) -> ConfigError:
-        return ConfigError(f"{source}: {key} must be {expected}, not {value!r}")
-
-    if hint is bool:
-        if not isinstance(value, bool):
-            raise wrong("true or false")
-        return value
-    if hint is int:
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise wrong("a whole number")
-        result: Any = value
-    elif hint is float:
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            raise wrong("a number")
-        result = float(value)
-    elif hint is str:
-        if not isinstance(value, str):
-            raise wrong("a string")
-        result = value
-    elif hint == tuple[int, ...]:
-        if not isinstance(value, list) or not all(isinstance(v, int) and not isinstance(v, bool) for v in value):
-            raise wrong("a list of whole numbers")
-        return tuple(value)
-    elif hint == dict[str, Any]:
-        if not isinstance(value, dict):
-            raise wrong("a table")
-        return dict(value)
-    else:
-        raise ConfigError(f"{source}: {key} has an unsupported type {hint}")
-    if "min" in meta and result < meta["min"]:
-        raise ConfigError(f"{source}: {key} = {value!r} is below the minimum {meta['min']}")
-    if key.endswith("socket_mode"):
-        try:
-            int(result, 8)
-        except ValueError:
-            raise wrong('an octal string like "0660"') from None
-    _check_choice(f"{source}: {key}", result, dict(meta))
-    return result
 
 
 def _rows(cls: type, prefix: str) -> list[tuple[str, str, Any, str]]:

@@ -9,6 +9,7 @@ of a task goes to the audit log (fsync'd) before it is announced.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import logging
 import os
 import threading
@@ -16,18 +17,25 @@ import time
 from collections import OrderedDict
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from agent.daemon.audit import AuditError, AuditLog
-from agent.daemon.config import Config
+from agent.daemon.config import Config, TranslatorConfig
 from agent.daemon.confirm import Question
 from agent.daemon.events import EventBus
 from agent.daemon.health import describe
 from agent.daemon.protocol import ProtocolError
 from agent.daemon.tasks import Busy, Peer, Task, TaskQueue, TaskState
-from agent.daemon.world_checks import check_world
+from agent.daemon.voice import Speech
+from agent.executor import ExecutionResult, StepEvent
+from agent.pipeline import Attempted, Cancelled, Draft, Pipeline, Rejected, TaskTranslator, Verified
+from agent.robot import Robot, Status
 from agent.translate.confidence import UNSURE_BELOW
-from agent.translate.explain import capabilities, explain
+from rsl.profile import Profile
+
+if TYPE_CHECKING:
+    from agent.record import Recorder
+    from agent.speech import SpeechEvent, Transcript
 
 log = logging.getLogger(__name__)
 
@@ -47,10 +55,12 @@ class Service:
         self.queue = TaskQueue(config.tasks.queue_size)
         self.audit = AuditLog(config.audit_path(), max_bytes=config.audit.max_bytes, keep=config.audit.keep)
         self.on_status = on_status
-        self.profile: Any = None
-        self.translator: Any = None
-        self.robot: Any = None
-        self.speech: Any = None
+        self.profile: Profile | None = None
+        self.translator: TaskTranslator | None = None
+        self.robot: Robot | None = None
+        # Set once all three above are loaded: the path a task takes (agent/pipeline.py).
+        self.pipeline: Pipeline | None = None
+        self.speech: Speech | None = None
         self.speech_problem = "not started"
         self.started = time.monotonic()
         self._lock = threading.Lock()
@@ -61,7 +71,6 @@ class Service:
         self._worker: threading.Thread | None = None
         self._worker_error: str | None = None
         self.warm_s: float | None = None
-        self._execute_plan: Callable[..., Any] | None = None
         self._questions: dict[str, Question] = {}
 
     # -- start and stop -------------------------------------------------------------------------
@@ -83,7 +92,7 @@ class Service:
         self.translator = _load_translator(self.config, self.profile)
         self.on_status(f"opening the {self.config.robot.backend} backend")
         self.robot = _open_robot(self.config, self.profile)
-        self._execute_plan = _load_executor()
+        self.pipeline = Pipeline(self.profile, self.translator, self.robot)
         if self.config.speech.enabled:
             self.on_status("starting speech input")
             self._start_speech()
@@ -259,10 +268,13 @@ class Service:
 
     def health(self) -> tuple[bool, dict[str, Any]]:
         robot: dict[str, Any] = {"ok": False, "backend": self.config.robot.backend}
-        try:
-            robot.update(ok=True, state=self.robot.state().to_dict())
-        except Exception as exc:
-            robot["detail"] = f"cannot read the robot state: {exc}"
+        if self.robot is None:
+            robot["detail"] = "the backend is not open"
+        else:
+            try:
+                robot.update(ok=True, state=self.robot.state().to_dict())
+            except Exception as exc:
+                robot["detail"] = f"cannot read the robot state: {exc}"
         speech: dict[str, Any] = {"ok": self.speech is not None}
         if self.speech is not None:
             try:
@@ -271,12 +283,13 @@ class Service:
                 speech.update(ok=False, detail=f"speech health check failed: {exc}")
         else:
             speech["detail"] = self.speech_problem
-        components = {
+        components: dict[str, dict[str, Any]] = {
             "worker": {"ok": self.alive(), **({"detail": self._worker_error} if self._worker_error else {})},
             "translator": {
                 "ok": self.translator is not None,
                 "warm_s": self.warm_s,
-                "model": getattr(self.translator, "model_name", None) or self.config.translator.model or "embedded",
+                "model": (self.translator.model_name if self.translator is not None else "")
+                or self.config.translator.model or "embedded",
             },
             "robot": robot,
             "audit": {"ok": self.audit._file is not None, "path": str(self.audit.path)},
@@ -334,8 +347,8 @@ class Service:
                 with self._lock:
                     self._current = None
             if self.speech is not None:
-                # `perceive` may have found objects; let speech recognition expect their names.
-                _quietly(lambda: self.speech.set_objects(self._known_objects() or []))
+                # A step may have found objects; let speech recognition expect their names.
+                _quietly(functools.partial(self.speech.set_objects, self._known_objects() or []))
             self.on_status(
                 self.idle_status()
                 if self._estop_reason is None
@@ -343,10 +356,11 @@ class Service:
             )
 
     def _warm_up(self) -> None:
-        examples = [c.task for c in self.profile.conventions] or [s.description for s in self.profile.skills]
+        pipeline = self._loaded()
+        examples = [c.task for c in pipeline.profile.conventions] or [s.description for s in pipeline.profile.skills]
         started = time.monotonic()
         try:
-            self.translator.translate(examples[0], known_objects=self._known_objects())
+            pipeline.translator.translate(examples[0], known_objects=self._known_objects())
         except Exception as exc:
             log.warning("the warm-up translation failed (tasks will still be tried): %s", exc)
             return
@@ -354,22 +368,24 @@ class Service:
         log.info("translator warm after %.1f s", self.warm_s)
 
     def _run(self, task: Task) -> None:
+        pipeline = self._loaded()
         start = time.monotonic()
         self.on_status(f"task {task.id}: {task.text or 'RSL program'}")
         if self._halted(task):
             return
         known = self._known_objects()
-        plan = self._translate(task, known, start) if task.text is not None else self._compile(task, known, start)
-        if plan is None:
+        draft = self._translate(task, known, start) if task.text is not None else self._compile(task, known, start)
+        if draft is None:
             return
-        world = check_world(plan, self.profile, self.robot)
-        if world.plan is None:
-            self._reject(task, world.refusal, [])
+        verified = pipeline.verify(draft)
+        if isinstance(verified, Rejected):
+            self._reject(task, verified.reason, [])
             return
-        plan = world.plan
-        task.program = plan.to_rsl()
-        task.plan = plan.to_list()
-        task.explanation = explain(plan, self.profile)
+        task.program = verified.program
+        task.plan = verified.plan.to_list()
+        task.explanation = verified.explanation
+        task.confidence = verified.confidence
+        task.doubts = list(verified.doubts)
         self.events.publish("verified", task.id, program=task.program, plan=task.plan,
                             explanation=task.explanation, confidence=task.confidence)
         if self._halted(task) or not self._confirmed(task):
@@ -377,75 +393,48 @@ class Service:
         task.state = TaskState.EXECUTING
         # The plan is on disk before the first command reaches the robot.
         self.audit.write(task.record())
-        self._execute(task, plan, start)
+        self._execute(task, verified, start)
 
-    def _translate(self, task: Task, known: list[str] | None, start: float) -> Any:
+    def _recording(self, task: Task) -> Callable[[Attempted], None]:
+        def record(attempt: Attempted) -> None:
+            entry = attempt.to_dict()
+            task.attempts.append(entry)
+            self.events.publish("attempt", task.id, **entry)
+
+        return record
+
+    def _translate(self, task: Task, known: list[str] | None, start: float) -> Draft | None:
         assert task.text is not None
         task.state = TaskState.TRANSLATING
         self.audit.write(task.record())
         self.events.publish("translating", task.id, text=task.text)
-
-        def on_attempt(attempt: Any) -> None:
-            entry = {
-                "pass": len(task.attempts) + 1,
-                "program": attempt.program,
-                "diagnostics": [d.to_dict() for d in attempt.diagnostics],
-            }
-            task.attempts.append(entry)
-            self.events.publish("attempt", task.id, **entry)
-
-        from agent.translate.engine import GenerationCancelled
-
-        try:
-            result = self.translator.translate(task.text, known_objects=known, on_attempt=on_attempt,
-                                               cancel=task.cancel)
-        except GenerationCancelled:
-            # Cut off mid-generation: a cancel or an estop need not wait for the translation to end.
-            task.mark("translate_ms", start)
-            self._finish(task, TaskState.CANCELLED, task.cancel.reason)
-            return None
+        translated = self._loaded().translate(task.text, known, cancel=task.cancel, on_attempt=self._recording(task))
         task.mark("translate_ms", start)
-        task.model = getattr(result, "model", None)
-        for name, value in (getattr(result, "timings_ms", None) or {}).items():
+        task.model = translated.model
+        for name, value in translated.timings_ms.items():
             task.timings_ms[f"translator.{name}"] = value
-        if len(task.attempts) < len(result.attempts):
-            # A translator that reported its attempts only at the end.
-            task.attempts[:] = [
-                {"pass": i, "program": a.program, "diagnostics": [d.to_dict() for d in a.diagnostics]}
-                for i, a in enumerate(result.attempts, 1)
-            ]
-        if task.cancel.is_set():
-            self._finish(task, TaskState.CANCELLED, task.cancel.reason)
+        if len(task.attempts) < len(translated.attempts):
+            # A task refused before the model was asked: its one attempt was not reported as it was made.
+            task.attempts[:] = [attempt.to_dict() for attempt in translated.attempts]
+        if isinstance(translated, Cancelled):
+            self._finish(task, TaskState.CANCELLED, translated.reason)
             return None
-        if not result.verified or result.plan is None:
-            last = task.attempts[-1]["diagnostics"] if task.attempts else []
-            if getattr(result, "refused", False):
-                self._reject(task, "not understood as a task for this robot; nothing moved. It can: "
-                             + capabilities(self.profile), last)
-            else:
-                self._reject(task, f"no verified program after {result.passes} attempt(s); nothing moved", last)
+        if isinstance(translated, Rejected):
+            self._reject(task, translated.reason, list(translated.diagnostics))
             return None
-        task.confidence = getattr(result, "confidence", None)
-        task.doubts = list(getattr(result, "doubts", ()))
-        return result.plan
+        return translated
 
-    def _compile(self, task: Task, known: list[str] | None, start: float) -> Any:
-        from rsl.compiler import compile_program
-
+    def _compile(self, task: Task, known: list[str] | None, start: float) -> Draft | None:
         assert task.rsl is not None
-        result = compile_program(task.rsl, self.profile, known)
+        compiled = self._loaded().compile(task.rsl, known, self._recording(task))
         task.mark("compile_ms", start)
-        diagnostics = [d.to_dict() for d in result.diagnostics]
-        entry = {"pass": 1, "program": task.rsl, "diagnostics": diagnostics}
-        task.attempts.append(entry)
-        self.events.publish("attempt", task.id, **entry)
-        if not result.ok:
-            self._reject(task, "the program does not compile; nothing moved", diagnostics)
+        if isinstance(compiled, Rejected):
+            self._reject(task, compiled.reason, list(compiled.diagnostics))
             return None
-        return result.plan
+        return compiled
 
-    def _execute(self, task: Task, plan: Any, start: float) -> None:
-        def on_step(step: Any) -> None:
+    def _execute(self, task: Task, verified: Verified, start: float) -> None:
+        def on_step(step: StepEvent) -> None:
             number = step.index  # 1-based
             if step.outcome is None:
                 if "first_command_ms" not in task.timings_ms:
@@ -456,7 +445,7 @@ class Service:
                 self.events.publish("executing", task.id, step=number, total=step.total, statement=step.statement)
                 if self.speech is not None:
                     # Spoken feedback ("moving forward two meters") when [speech.options] feedback is on.
-                    self.speech.announce(plan.commands[number - 1])
+                    self.speech.announce(verified.plan.commands[number - 1])
                 return
             outcome = {"status": step.outcome.status.value, "reason": step.outcome.reason}
             task.steps.append(
@@ -472,30 +461,25 @@ class Service:
                 "step", task.id, step=number, total=step.total, statement=step.statement, outcome=outcome
             )
 
-        assert self._execute_plan is not None, "load() sets the executor"
+        pipeline = self._loaded()
         recorder = self._recorder(task)
         on_event = on_step if recorder is None else _both(recorder.on_event, on_step)
         speech = self.speech
         if speech is not None:
             # While the robot moves, a stop-only listener hears "stop" without the wake word (barge-in).
             _quietly(lambda: speech.guard(True))
-        result = None
+        finished = None
         try:
-            result = self._execute_plan(plan, self.robot, self.profile, cancel=task.cancel, on_event=on_event)
+            finished = pipeline.execute(verified, cancel=task.cancel, on_event=on_event)
         finally:
             if speech is not None:
                 _quietly(lambda: speech.guard(False))
             if recorder is not None:
-                _save_pictures(task, recorder, result)
+                _save_pictures(task, recorder, finished.execution if finished is not None else None)
         task.mark("total_ms", start)
-        status = getattr(result.status, "value", result.status)
-        final_state = result.final_state.to_dict() if result.final_state is not None else None
-        if status == "done":
-            self._finish(task, TaskState.DONE, "", robot_state=final_state)
-        elif status == "cancelled":
-            self._finish(task, TaskState.CANCELLED, task.cancel.reason or _last_reason(result), robot_state=final_state)
-        else:
-            self._finish(task, TaskState.FAILED, _last_reason(result) or "a step failed", robot_state=final_state)
+        state = {Status.DONE: TaskState.DONE, Status.CANCELLED: TaskState.CANCELLED}.get(finished.status,
+                                                                                         TaskState.FAILED)
+        self._finish(task, state, finished.reason, robot_state=finished.robot_state)
 
     def confirm(self, task_id: str, accept: bool, by: str) -> Task:
         """Answer the open question about `task_id`; raises `not_waiting` when none is open."""
@@ -541,19 +525,24 @@ class Service:
 
     def _say(self, text: str, *, wait_s: float = 0.0) -> None:
         """Spoken feedback, when speech is on and its feedback is enabled; never fails the task."""
-        if self.speech is not None:
-            _quietly(lambda: self.speech.say(text, wait_s=wait_s))
+        speech = self.speech
+        if speech is not None:
+            _quietly(lambda: speech.say(text, wait_s=wait_s))
 
     # -- helpers ---------------------------------------------------------------------------
 
-    def _recorder(self, task: Task) -> Any:
+    def _loaded(self) -> Pipeline:
+        assert self.pipeline is not None, "load() sets up the pipeline before the worker starts"
+        return self.pipeline
+
+    def _recorder(self, task: Task) -> Recorder | None:
         """Pictures of this task's run when [robot] record names a directory; they never fail a task."""
         if not self.config.robot.record:
             return None
         try:
             from agent.record import Recorder
 
-            return Recorder(Path(self.config.robot.record).expanduser() / task.id, self.robot, gif=True)
+            return Recorder(Path(self.config.robot.record).expanduser() / task.id, self._loaded().robot, gif=True)
         except Exception as exc:
             log.warning("task %s: no pictures: %s", task.id, exc)
             return None
@@ -600,18 +589,12 @@ class Service:
             self._tasks.popitem(last=False)
 
     def _known_objects(self) -> list[str] | None:
-        """The objects programs may name; None leaves names to the robot to check.
-
-        Until the robot has perceived anything, every name is left open:
-        rejecting "grasp the cup" before the robot has looked would refuse
-        tasks it can carry out, since backends look for an object on demand.
-        """
+        """The objects programs may name (`Pipeline.known_objects`); None also when the robot cannot say."""
         try:
-            known = [name for name, _x, _y in self.robot.state().known_objects]
+            return self._loaded().known_objects()
         except Exception as exc:
             log.warning("cannot read the known objects from the robot: %s", exc)
             return None
-        return known or None
 
     def _stop_robot(self) -> None:
         if self.robot is None:
@@ -633,7 +616,7 @@ class Service:
             self.speech_problem = f"{type(exc).__name__}: {exc}"
             log.warning("speech input is off: %s; the socket API keeps working", self.speech_problem)
 
-    def _on_transcript(self, transcript: Any) -> None:
+    def _on_transcript(self, transcript: Transcript) -> None:
         text = str(transcript.text).strip()
         if not text:
             return
@@ -644,7 +627,7 @@ class Service:
             log.info("heard %r: robot stopped, cancelled %s", text, cancelled or "nothing")
             self.events.publish("speech", None, state="stop", detail={"text": text, "cancelled": cancelled})
             return
-        if getattr(transcript, "source", None) == "barge_in":
+        if transcript.source == "barge_in":
             return  # the stop listener only ever stops; nothing it hears becomes a task or an answer
         reply = yes_or_no(text)
         with self._lock:
@@ -653,7 +636,7 @@ class Service:
             self.confirm(open_questions[0], reply, "voice")
             log.info("heard %r: task %s %s", text, open_questions[0], "accepted" if reply else "declined")
             return
-        heard = transcript.to_dict() if hasattr(transcript, "to_dict") else {"text": text}
+        heard = transcript.to_dict()
 
         def announce(task: Task) -> None:
             task.transcript = heard
@@ -665,24 +648,16 @@ class Service:
             log.warning("spoken task %r not queued: %s", text, exc.message)
             self.events.publish("speech", None, state="dropped", detail={"text": text, "reason": exc.message})
 
-    def _on_speech_event(self, event: Any) -> None:
-        detail = event.to_dict() if hasattr(event, "to_dict") else {}
-        self.events.publish("speech", None, state=str(getattr(event, "kind", event)), detail=detail)
+    def _on_speech_event(self, event: SpeechEvent) -> None:
+        self.events.publish("speech", None, state=event.kind, detail=event.to_dict())
 
 
-def _needs_restart(translator: Any) -> Any:
+def _needs_restart(translator: TranslatorConfig) -> TranslatorConfig:
     """The translator settings that take a restart: all but the confirm policy, which applies at once."""
     return dataclasses.replace(translator, confirm="", confirm_timeout=0.0)
 
 
-def _last_reason(result: Any) -> str:
-    for outcome in reversed(list(getattr(result, "outcomes", ()) or ())):
-        if getattr(outcome, "reason", ""):
-            return str(outcome.reason)
-    return ""
-
-
-def _save_pictures(task: Task, recorder: Any, result: Any) -> None:
+def _save_pictures(task: Task, recorder: Recorder, result: ExecutionResult | None) -> None:
     try:
         pictures = recorder.finish(result, title=task.text or "RSL program")
         log.info("task %s: %d picture(s) in %s", task.id, len(pictures), pictures[0].parent)
@@ -690,12 +665,12 @@ def _save_pictures(task: Task, recorder: Any, result: Any) -> None:
         log.warning("task %s: the pictures were not saved: %s", task.id, exc)
 
 
-def _both(pictures: Callable[[Any], None], on_step: Callable[[Any], None]) -> Callable[[Any], None]:
-    def call(event: Any) -> None:
+def _both(pictures: Callable[[StepEvent], None], on_step: Callable[[StepEvent], None]) -> Callable[[StepEvent], None]:
+    def call(event: StepEvent) -> None:
         try:
             pictures(event)
         except Exception as exc:  # a picture is never worth a step
-            log.warning("a picture of step %s was not saved: %s", getattr(event, "index", "?"), exc)
+            log.warning("a picture of step %s was not saved: %s", event.index, exc)
         on_step(event)
 
     return call
@@ -708,7 +683,7 @@ def _quietly(action: Callable[[], Any]) -> None:
         log.exception("error while shutting down")
 
 
-def _load_profile(path: str) -> Any:
+def _load_profile(path: str) -> Profile:
     from rsl.profile import ProfileError, load_profile
 
     try:
@@ -717,7 +692,7 @@ def _load_profile(path: str) -> Any:
         raise StartupError(f"{exc}\n  = help: fix the profile or set robot.profile in the config") from exc
 
 
-def _load_translator(config: Config, profile: Any) -> Any:
+def _load_translator(config: Config, profile: Profile) -> TaskTranslator:
     settings = config.translator
     try:
         from agent.translate import Translator
@@ -738,17 +713,7 @@ def _load_translator(config: Config, profile: Any) -> Any:
         ) from exc
 
 
-def _load_executor() -> Callable[..., Any]:
-    try:
-        from agent.executor import execute
-    except ImportError as exc:
-        raise StartupError(
-            f"cannot load the plan executor: {exc}\n  = help: reinstall nrtrans; agent/executor.py is part of it"
-        ) from exc
-    return execute
-
-
-def _open_robot(config: Config, profile: Any) -> Any:
+def _open_robot(config: Config, profile: Profile) -> Robot:
     settings = config.robot
     try:
         from agent.backends import open_robot

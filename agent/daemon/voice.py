@@ -10,15 +10,42 @@ own health.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any, Protocol
+
+from rsl.plan import Command
+
+if TYPE_CHECKING:
+    from agent.speech import SpeechEvent, Transcript
+
+
+class Speech(Protocol):
+    """What the service uses of the speech input (`agent.speech.SpeechInput`)."""
+
+    def listen_now(self) -> None:
+        """Start listening for a task without the wake word; RuntimeError says why it cannot."""
+
+    def guard(self, moving: bool) -> None:
+        """While the robot moves, listen for a spoken stop without the wake word."""
+
+    def announce(self, command: Command) -> bool:
+        """Say the step about to run, when spoken feedback is on."""
+
+    def say(self, text: str, *, wait_s: float = 0.0) -> bool: ...
+
+    def set_objects(self, names: tuple[str, ...] | list[str]) -> None:
+        """Expect these object names in what is said next."""
+
+    def health(self) -> dict[str, Any]: ...
+
+    def stop(self) -> None: ...
 
 
 def start_speech(
     options: dict[str, Any],
     profile_path: str,
-    on_transcript: Callable[[Any], None],
-    on_event: Callable[[Any], None],
-) -> Any:
+    on_transcript: Callable[[Transcript], None],
+    on_event: Callable[[SpeechEvent], None],
+) -> Speech:
     from agent.speech import SpeechConfig, SpeechInput
 
     # Recognition is biased toward the words of the same robot profile the daemon uses.

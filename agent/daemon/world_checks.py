@@ -114,9 +114,12 @@ def check_world(plan: Plan, profile: Profile, robot: Any) -> WorldCheck:
                              (t for t in seen if t.name != holding))
             if hit is not None:
                 thing, at = hit
+                approach = profile.bound_to("approach_object")
+                stop_there = (f", or `{approach.keyword} {thing.name};` to stop in front of it"
+                              if approach is not None else "")
                 return WorldCheck(None, f"`{command.to_rsl()}` (line {command.line}) would drive into the "
                                         f"{thing.name} after about {at:.1f} m; nothing moved. Drive less than "
-                                        f"{max(0.0, at):.1f} m, or `approach {thing.name};` to stop in front of it.")
+                                        f"{max(0.0, at):.1f} m{stop_there}.")
             x, y = x + distance * math.cos(bearing), y + distance * math.sin(bearing)
         elif tracking and moves == "turn":
             assert primitive is not None and isinstance(command.args[0], Quantity)

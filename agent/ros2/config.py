@@ -2,45 +2,51 @@
 
 The `[ros]` table of the robot profile is the one place a robot's topic,
 service and joint names live; this module fills in defaults for the keys a
-profile leaves out and rejects values of the wrong type with a clear message.
+profile leaves out and, through rsl/settings.py, rejects unknown keys and
+values of the wrong type or range with a clear message.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from typing import Any
 
 from rsl.profile import Profile, ProfileError
+from rsl.settings import read_settings, setting
+
+
+def _name(default: str, doc: str) -> Any:
+    return setting(default, doc=doc, nonempty=True)
+
+
+def _seconds(default: float, doc: str) -> Any:
+    return setting(default, doc=doc, above=0.0)
 
 
 @dataclass(frozen=True)
 class RosConfig:
-    cmd_vel: str = "/cmd_vel"
-    odom: str = "/odom"
-    joint_states: str = "/joint_states"
-    head_trajectory: str = "/head_controller/joint_trajectory"
-    gripper_trajectory: str = "/gripper_controller/joint_trajectory"
-    goal_pose: str = "/goal_pose"
-    perceive_service: str = "/perceive"
-    objects_topic: str = "/objects"
-    grasp_service: str = "/grasp"
-    head_pan_joint: str = "head_pan_joint"
-    head_tilt_joint: str = "head_tilt_joint"
-    gripper_joint: str = "gripper_joint"
-    # Gripper joint positions (finger opening in metres on most grippers).
-    gripper_open_position: float = 0.04
-    gripper_closed_position: float = 0.0
-    # The frame goal poses are given in; odometry's frame on the robots we target.
-    world_frame: str = "odom"
-    # Metres from a goal pose that count as arrived; at least the navigation stack's own
-    # goal tolerance (Nav2's xy_goal_tolerance), or goals end as failures.
-    goal_tolerance: float = 0.03
-    # Seconds without odometry before a moving base is stopped and the step fails.
-    odom_timeout: float = 0.5
-    # Seconds to wait for the robot's first odometry before giving up on the link.
-    connect_timeout: float = 10.0
-    # Seconds a service (perceive, grasp) may take to answer.
-    service_timeout: float = 5.0
+    cmd_vel: str = _name("/cmd_vel", "base velocity commands (geometry_msgs/Twist)")
+    odom: str = _name("/odom", "odometry (nav_msgs/Odometry)")
+    joint_states: str = _name("/joint_states", "head and gripper joint feedback")
+    head_trajectory: str = _name("/head_controller/joint_trajectory", "head JointTrajectory commands")
+    gripper_trajectory: str = _name("/gripper_controller/joint_trajectory", "gripper JointTrajectory commands")
+    goal_pose: str = _name("/goal_pose", "Nav2-style navigation goals (geometry_msgs/PoseStamped)")
+    # Named after the primitives they serve unless the profile names them.
+    perceive_service: str = _name("/perceive_objects", "the perceive_objects primitive's Trigger service")
+    objects_topic: str = _name("/objects", "object positions and what is held (std_msgs/String, JSON)")
+    grasp_service: str = _name("/grasp_object", "the grasp_object primitive's Trigger service")
+    head_pan_joint: str = _name("head_pan_joint", "the head's pan joint")
+    head_tilt_joint: str = _name("head_tilt_joint", "the head's tilt joint")
+    gripper_joint: str = _name("gripper_joint", "the gripper's joint")
+    gripper_open_position: float = setting(0.04, doc="gripper joint position when open (finger opening, m)")
+    gripper_closed_position: float = setting(0.0, doc="gripper joint position when closed")
+    world_frame: str = _name("odom", "the frame goal poses are given in; odometry's frame on the robots we target")
+    goal_tolerance: float = setting(0.03, above=0.0, doc=(
+        "metres from a goal pose that count as arrived; at least the navigation stack's own goal tolerance "
+        "(Nav2's xy_goal_tolerance), or goals end as failures"))
+    odom_timeout: float = _seconds(0.5, "seconds without odometry before a moving base is stopped and the step fails")
+    connect_timeout: float = _seconds(10.0, "seconds to wait for the robot's first odometry before giving up")
+    service_timeout: float = _seconds(5.0, "seconds a primitive's service may take to answer")
 
     @classmethod
     def from_profile(cls, profile: Profile) -> RosConfig:
@@ -48,26 +54,4 @@ class RosConfig:
 
     @classmethod
     def from_mapping(cls, raw: dict[str, Any], source: str = "<profile>") -> RosConfig:
-        known = {f.name: f for f in fields(cls)}
-        unknown = sorted(set(raw) - set(known))
-        if unknown:
-            raise ProfileError(
-                f"{source}: unknown [ros] settings: {', '.join(unknown)}; "
-                f"the known ones are {', '.join(known)}"
-            )
-        values: dict[str, Any] = {}
-        for key, value in raw.items():
-            default = known[key].default
-            if isinstance(default, float):
-                if isinstance(value, bool) or not isinstance(value, int | float):
-                    raise ProfileError(f"{source}: [ros] {key} must be a number, got {value!r}")
-                if key.endswith("_timeout") and value <= 0:
-                    raise ProfileError(f"{source}: [ros] {key} must be a positive number of seconds")
-                if key == "goal_tolerance" and value <= 0:
-                    raise ProfileError(f"{source}: [ros] goal_tolerance must be a positive number of metres")
-                values[key] = float(value)
-            else:
-                if not isinstance(value, str) or not value:
-                    raise ProfileError(f"{source}: [ros] {key} must be a non-empty name")
-                values[key] = value
-        return cls(**values)
+        return read_settings(cls, raw, error=ProfileError, source=source, prefix="ros.", docs="docs/ros2.md")

@@ -22,15 +22,16 @@ A scene is a TOML file:
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
-from typing import Any
 
 from agent.robot import Pose
+from rsl.settings import read_settings, setting
 
 KINDS = ("graspable", "furniture", "fixed")
 SHAPES = ("box", "cylinder", "sphere")
@@ -44,16 +45,20 @@ class SceneError(ValueError):
 
 @dataclass(frozen=True)
 class SceneObject:
-    name: str
-    x: float
-    y: float
-    z: float  # height of the centre above the floor
-    kind: str = "graspable"
-    shape: str = "box"
-    size: tuple[float, float, float] = (0.1, 0.1, 0.1)
-    mass: float = 0.3
-    yaw: float = 0.0
-    color: tuple[float, float, float] = (0.6, 0.6, 0.6)
+    """One `[[objects]]` table."""
+
+    name: str = setting(doc="what programs call it: an identifier like `cup` or `red_ball`")
+    x: float = setting(doc="m, world frame; every object needs x and y")
+    y: float = setting(doc="m, world frame; every object needs x and y")
+    # Not given in the file: half the object's height, so it stands on the floor.
+    z: float = setting(math.nan, doc="m, the height of the object's centre above the floor")
+    kind: str = setting("graspable", choices=KINDS, doc="graspable, furniture (cannot be picked up) or fixed")
+    shape: str = setting("box", choices=SHAPES, doc="box, cylinder or sphere")
+    size: tuple[float, float, float] = setting((0.1, 0.1, 0.1), length=3, above=0.0,
+                                               doc="m, extent along x, y and z")
+    mass: float = setting(0.3, above=0.0, doc="kg")
+    yaw: float = setting(0.0, doc="rad")
+    color: tuple[float, float, float] = setting((0.6, 0.6, 0.6), length=3, min=0.0, max=1.0, doc="red, green, blue")
 
     @property
     def graspable(self) -> bool:
@@ -105,55 +110,32 @@ def load_scene(path: str | Path | None = None) -> Scene:
     return parse_scene(text, source=str(scene_path))
 
 
+@dataclass(frozen=True)
+class _Start:
+    x: float = setting(0.0, doc="m")
+    y: float = setting(0.0, doc="m")
+    heading: float = setting(0.0, doc="rad, counter-clockwise from +x")
+
+
+@dataclass(frozen=True)
+class _SceneFile:
+    start: _Start = field(default_factory=_Start, metadata={"doc": "where the robot starts"})
+    objects: tuple[SceneObject, ...] = setting((), doc="the named objects")
+
+
 def parse_scene(text: str, source: str = "<scene>") -> Scene:
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{source}: not valid TOML: {exc}") from exc
-    start = data.get("start", {})
-    try:
-        pose = Pose(float(start.get("x", 0.0)), float(start.get("y", 0.0)), float(start.get("heading", 0.0)))
-    except (TypeError, ValueError):
-        raise SceneError(f"{source}: [start] x, y and heading must be numbers") from None
+    scene = read_settings(_SceneFile, data, error=SceneError, source=source, docs="docs/simulator.md")
     objects: list[SceneObject] = []
-    for index, raw in enumerate(data.get("objects", []), start=1):
-        obj = _object(raw, f"{source}: object #{index}")
+    for index, obj in enumerate(scene.objects, start=1):
+        if not _IDENTIFIER.match(obj.name):
+            raise SceneError(f"{source}: objects[{index}].name {obj.name!r} must be an identifier like `cup` or "
+                             "`red_ball`, because programs refer to it by name")
         if any(o.name == obj.name for o in objects):
             raise SceneError(f"{source}: object `{obj.name}` is declared twice; names must be unique")
-        objects.append(obj)
-    return Scene(objects=tuple(objects), start=pose, name=Path(source).stem)
-
-
-def _object(raw: dict[str, Any], where: str) -> SceneObject:
-    name = raw.get("name")
-    if not isinstance(name, str) or not _IDENTIFIER.match(name):
-        raise SceneError(f"{where}: name {name!r} must be an identifier like `cup` or `red_ball`, "
-                         "because programs refer to it by name")
-    where = f"{where} (`{name}`)"
-    kind = raw.get("kind", "graspable")
-    if kind not in KINDS:
-        raise SceneError(f"{where}: kind {kind!r} must be one of {', '.join(KINDS)}")
-    shape = raw.get("shape", "box")
-    if shape not in SHAPES:
-        raise SceneError(f"{where}: shape {shape!r} must be one of {', '.join(SHAPES)}")
-    try:
-        size = _triple(raw.get("size", (0.1, 0.1, 0.1)))
-        color = _triple(raw.get("color", (0.6, 0.6, 0.6)))
-        x, y = float(raw["x"]), float(raw["y"])
-        z = float(raw.get("z", size[2] / 2.0))
-        mass = float(raw.get("mass", 0.3))
-        yaw = float(raw.get("yaw", 0.0))
-    except KeyError as exc:
-        raise SceneError(f"{where}: missing {exc.args[0]!r}; every object needs x and y") from None
-    except (TypeError, ValueError):
-        raise SceneError(f"{where}: x, y, z, mass and yaw must be numbers; size and color lists of three") \
-            from None
-    if min(size) <= 0 or mass <= 0:
-        raise SceneError(f"{where}: size and mass must be positive")
-    return SceneObject(name=name, x=x, y=y, z=z, kind=kind, shape=shape, size=size, mass=mass,
-                       yaw=yaw, color=color)
-
-
-def _triple(value: Any) -> tuple[float, float, float]:
-    a, b, c = (float(v) for v in value)
-    return a, b, c
+        objects.append(dataclasses.replace(obj, z=obj.size[2] / 2.0) if math.isnan(obj.z) else obj)
+    start = Pose(scene.start.x, scene.start.y, scene.start.heading)
+    return Scene(objects=tuple(objects), start=start, name=Path(source).stem)

@@ -1,9 +1,9 @@
 """Per-language words the recogniser is biased toward, besides the profile's own.
 
-The skill words come from the robot profile (keywords and aliases) for
-English. A model in another language cannot hear English keywords, so a
-lexicon may give words for a skill keyword; a keyword it does not cover is
-simply not biased for. Number and unit words for English are the task
+The skill words come from the robot profile: keywords and aliases for
+English, and a skill's `words` for another language, whose model cannot hear
+English keywords (a skill without words in that language is simply not
+biased for). Number and unit words for English are the task
 normalizer's, so the recogniser can produce every number word the
 normalizer can read.
 """
@@ -24,9 +24,6 @@ class Lexicon:
     units: tuple[str, ...]
     # Words that join clauses or carry references, such as "then" and "it".
     connectives: tuple[str, ...]
-    # Skill keyword -> words a speaker of this language says for it. Empty
-    # for English, whose words come from the profile itself.
-    skill_words: dict[str, tuple[str, ...]] = field(default_factory=dict)
     # Object name (as RSL knows it) -> spoken words in this language.
     object_words: dict[str, tuple[str, ...]] = field(default_factory=dict)
     # Said before the task and stripped from the transcript.
@@ -69,20 +66,6 @@ KOREAN = Lexicon(
              "하나", "둘", "셋", "넷", "다섯", "한", "두", "세", "네"),
     units=("미터", "센티미터", "도", "라디안", "번", "바퀴"),
     connectives=("그리고", "다음", "다시", "으로", "을", "를", "까지", "살짝", "조금", "그", "것"),
-    skill_words={
-        "forward": ("앞으로", "전진"),
-        "backward": ("뒤로", "후진"),
-        "turnleft": ("왼쪽", "회전", "돌아"),
-        "turnright": ("오른쪽", "회전", "돌아"),
-        "lookup": ("위", "위로", "봐"),
-        "lookdown": ("아래", "아래로", "봐"),
-        "lookleft": ("왼쪽", "봐"),
-        "lookright": ("오른쪽", "봐"),
-        "perceive": ("찾아", "인식"),
-        "approach": ("접근", "가"),
-        "grasp": ("잡아",),
-        "goto": ("이동", "원점", "돌아가"),
-    },
     object_words={"cup": ("컵", "컵을"), "box": ("상자",), "ball": ("공",), "table": ("테이블",)},
     wake_words=("로봇",),
     stop_words=("멈춰", "정지", "그만", "스톱", "중지"),

@@ -235,14 +235,24 @@ def phrase_end(words: list[dict[str, Any]], phrases: Sequence[tuple[str, ...]]) 
     return None
 
 
+def _after_cut(word: dict[str, Any], cut_s: float) -> bool:
+    """Whether a word of the task recogniser was said after the wake word that ended at `cut_s`.
+
+    By the middle of the word: a task recogniser that hears the tail of the
+    wake word as a short word places it before the cut. And by its end: a word
+    that ends with the wake word is the wake word heard as something else (a
+    lone "로봇" heard as the number word "오" at 0.72-0.87 s, cut at 0.87 s),
+    which the middle alone let through at some block alignments.
+    """
+    start, end = float(word.get("start", 0.0)), float(word.get("end", 0.0))
+    return (start + end) / 2 >= cut_s - TIME_SLACK_S and end > cut_s + TIME_SLACK_S
+
+
 def words_after(result: dict[str, Any], cut_s: float | None, wake_words: Sequence[str]) -> str:
     """The transcript of `result` after time `cut_s`, without a leading wake word or noise markers."""
     words = result.get("result")
     if words and cut_s is not None:
-        # By the middle of each word: a task recogniser that hears the tail of
-        # the wake word as a short word places it before the cut.
-        kept = [str(w["word"]) for w in words
-                if (float(w.get("start", 0.0)) + float(w.get("end", 0.0))) / 2 >= cut_s - TIME_SLACK_S]
+        kept = [str(w["word"]) for w in words if _after_cut(w, cut_s)]
     elif words:
         kept = [str(w["word"]) for w in words]
     else:

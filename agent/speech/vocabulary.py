@@ -2,9 +2,10 @@
 
 Vosk's runtime grammar is a closed word list: the recogniser then only ever
 outputs those words (plus `[unk]` where the model has it). The list is built
-from the robot profile (skill keywords and their aliases), the objects the
-robot knows, and the language's number, unit and joining words, then cut
-down to the words the model can actually pronounce.
+from the robot profile (skill keywords and their aliases, or a skill's words
+in the language), the objects the robot knows, and the language's number,
+unit and joining words, then cut down to the words the model can actually
+pronounce.
 """
 
 from __future__ import annotations
@@ -49,7 +50,7 @@ def wanted_words(profile: Profile, lexicon: Lexicon, objects: Iterable[str] = ()
         if lexicon.language == "en":
             for name in (skill.keyword, *skill.aliases):
                 words.extend(name.split("_"))
-        words.extend(lexicon.skill_words.get(skill.keyword, ()))
+        words.extend(skill.words_in(lexicon.language))
     for name in objects:
         spoken = lexicon.object_words.get(name)
         if spoken:

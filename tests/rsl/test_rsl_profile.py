@@ -69,3 +69,34 @@ def test_missing_profile_file_is_a_clear_error(tmp_path):
 def test_not_toml_is_a_clear_error():
     with pytest.raises(ProfileError, match="not valid TOML"):
         parse_profile("[[skills]\n", source="bad.toml")
+
+
+def test_words_in_another_language_come_from_the_profile_and_leave_the_digest(profile):
+    forward = profile.skill("forward")
+    assert forward is not None and forward.words_in("ko") == ("앞으로", "전진")
+    assert forward.words_in("en") == ()
+    text = default_profile_path().read_text()
+    without = parse_profile(text.replace('words = { ko = ["앞으로", "전진"] }\n', ""), source="plain.toml")
+    assert without.digest == profile.digest, "words are how a skill is heard, not what an adapter learned"
+    with pytest.raises(ProfileError, match="`words` must map a language code"):
+        parse_profile(text.replace('words = { ko = ["앞으로", "전진"] }', 'words = { ko = "앞으로" }'),
+                      source="broken.toml")
+
+
+@pytest.mark.parametrize(("patch", "replacement", "message"), [
+    ("max_linear_speed = 0.5", 'max_linear_speed = "fast"',
+     "my.toml: motion.max_linear_speed must be a number, not 'fast'"),
+    ("max_statements = 64", 'max_statements = "many"',
+     "my.toml: limits.max_statements must be a whole number, not 'many'"),
+    ("max_statements = 64", "max_statements = 0", "my.toml: limits.max_statements = 0 is below the minimum 1"),
+    ("reach = 0.8", "reach = 0.8\nreech = 1",
+     "my.toml: unknown setting motion.reech\n  = help: the settings here are motion.max_linear_speed, "
+     "motion.max_angular_speed, motion.max_linear_accel, motion.max_angular_accel, motion.max_head_speed, "
+     "motion.reach, motion.standoff, motion.timeout_margin, motion.width; see docs/skills.md"),
+])
+def test_profile_settings_are_checked_like_every_other_setting(patch, replacement, message):
+    text = default_profile_path().read_text()
+    assert patch in text
+    with pytest.raises(ProfileError) as caught:
+        parse_profile(text.replace(patch, replacement, 1), source="my.toml")
+    assert str(caught.value) == message

@@ -24,9 +24,15 @@ def test_default_scene_has_the_named_objects() -> None:
 
 @pytest.mark.parametrize(("text", "message"), [
     ("[[objects]]\nname = 'Big Cup'\nx = 1\ny = 1\n", "must be an identifier"),
-    ("[[objects]]\nname = 'cup'\nx = 1\n", "every object needs x and y"),
-    ("[[objects]]\nname = 'cup'\nx = 1\ny = 0\nshape = 'cone'\n", "shape 'cone' must be one of box"),
-    ("[[objects]]\nname = 'cup'\nx = 1\ny = 0\nsize = [0, 1, 1]\n", "size and mass must be positive"),
+    ("[[objects]]\nname = 'cup'\nx = 1\n", r"objects\[1\]\.y must be given: .*every object needs x and y"),
+    ("[[objects]]\nname = 'cup'\nx = 1\ny = 0\nshape = 'cone'\n",
+     r"objects\[1\]\.shape = 'cone' is not one of 'box', 'cylinder', 'sphere'"),
+    ("[[objects]]\nname = 'cup'\nx = 1\ny = 0\nsize = [0, 1, 1]\n",
+     r"objects\[1\]\.size = \[0, 1, 1\]: 0\.0 is not above"),
+    ("[[objects]]\nname = 'cup'\nx = 1\ny = 0\nsize = [1, 1]\n", r"objects\[1\]\.size must have 3 items"),
+    ("[[objects]]\nname = 'cup'\nx = 1\ny = 0\ncolour = [1, 0, 0]\n",
+     r"unknown setting objects\[1\]\.colour\n  = help: the settings here are objects\[1\]\.name, "),
+    ("[start]\nx = 'near'\n", r"test\.toml: start\.x must be a number, not 'near'"),
     ("[[objects]]\nname = 'a'\nx = 1\ny = 0\n[[objects]]\nname = 'a'\nx = 2\ny = 0\n", "declared twice"),
     ("[start\n", "not valid TOML"),
 ])

@@ -42,9 +42,10 @@ def hear(collector, play: Callable[[], None], tries: int = 2, timeout: float = 1
     raise AssertionError(f"no transcript after {tries} tries; events: {collector.kinds()}")
 
 
-def assert_heard(text: str, said: str) -> None:
+def assert_heard(text: str, said: str, context: str = "") -> None:
     """The task's first word exactly (so no wake word is left over) and at most one word in two wrong."""
     from agent.speech.wer import word_errors
 
-    assert text.split()[:1] == said.split()[:1], f"heard {text!r} for {said!r}"
-    assert word_errors(said, text) <= len(said.split()) / 2, f"heard {text!r} for {said!r}"
+    message = f"heard {text!r} for {said!r}" + (f": {context}" if context else "")
+    assert text.split()[:1] == said.split()[:1], message
+    assert word_errors(said, text) <= len(said.split()) / 2, message

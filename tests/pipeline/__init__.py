@@ -1,0 +1,1 @@
+"""The task pipeline, driven without the daemon or its socket."""

@@ -1,0 +1,1 @@
+"""Settings read through rsl/settings.py."""
