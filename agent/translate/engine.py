@@ -51,6 +51,9 @@ class Generation:
     first_probability: float | None = None  # None: this engine cannot tell
     # Each chosen token's probability among the tokens the grammar allowed there; empty: cannot tell.
     token_probabilities: tuple[float, ...] = ()
+    # Where the model could have ended the program but went on: (statements written so far, how many
+    # tokens were chosen before that point, the probability it gave to ending there).
+    endings: tuple[tuple[int, int, float], ...] = ()
 
 
 def use_plain_cpu_buffers() -> None:
@@ -167,6 +170,7 @@ class TokenMasks:
         self.vocabulary = vocabulary
         self._cache: dict[State, tuple[np.ndarray, list[State]]] = {}
         self._closing: dict[State, tuple[np.ndarray, list[State]]] = {}
+        self._ends: dict[State, np.ndarray] = {}
 
     def closing(self, state: State) -> tuple[np.ndarray, list[State]]:
         """The tokens from `state` that end the program without starting another statement."""
@@ -177,6 +181,14 @@ class TokenMasks:
                     and b";" not in self.vocabulary.pieces[int(ids[i])]]
             found = (ids[keep], [states[i] for i in keep])
             self._closing[state] = found
+        return found
+
+    def ends(self, state: State) -> np.ndarray:
+        """Positions in `at(state)` of the tokens that end the program."""
+        found = self._ends.get(state)
+        if found is None:
+            found = self._ends[state] = np.asarray([i for i, s in enumerate(self.at(state)[1]) if s == END],
+                                                   dtype=np.int64)
         return found
 
     def at(self, state: State) -> tuple[np.ndarray, list[State]]:
@@ -281,6 +293,7 @@ class LocalEngine:
         pieces = self.vocabulary.pieces
         first_piece, first_probability = "", 0.0
         chosen: list[float] = []
+        endings: list[tuple[int, int, float]] = []
         while generated < max_tokens:
             check()
             logits = np.ctypeslib.as_array(llama_cpp.llama_get_logits_ith(llm._ctx.ctx, -1), shape=(n_vocab,))
@@ -300,7 +313,12 @@ class LocalEngine:
                     break
                 allowed = logits[ids]
                 choice = int(np.argmax(allowed))
-                chosen.append(float(1.0 / np.exp(allowed - allowed[choice]).sum()))
+                weights = np.exp(allowed - allowed[choice])
+                chosen.append(float(1.0 / weights.sum()))
+                ending = masks.ends(state)
+                if len(ending) and states[choice] != END:
+                    endings.append((out.count(b";"), len(chosen) - 1,
+                                    float(weights[ending].sum() / weights.sum())))
                 token, state = int(ids[choice]), states[choice]
             out += pieces[token]
             generated += 1
@@ -315,7 +333,7 @@ class LocalEngine:
         return Generation(text=text, prompt_tokens=len(tokens), reused_tokens=reused, generated_tokens=generated,
                           prompt_ms=(prompt_done - started) * 1000, generate_ms=(done - prompt_done) * 1000,
                           finished=finished, first_piece=first_piece, first_probability=first_probability,
-                          token_probabilities=tuple(chosen))
+                          token_probabilities=tuple(chosen), endings=tuple(endings))
 
     def close(self) -> None:
         close = getattr(self.llm, "close", None)

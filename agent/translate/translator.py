@@ -23,7 +23,7 @@ from agent.adapter.card import AdapterCard, card_path, read_card
 from agent.normalize import normalize_task
 from agent.translate.automaton import RslAutomaton
 from agent.translate.clauses import Clause, split_clauses
-from agent.translate.confidence import judge
+from agent.translate.confidence import assess, judge
 from agent.translate.engine import CancelFlag, Generation
 from agent.translate.model_path import ModelNotFoundError
 from agent.translate.prompt import (
@@ -38,7 +38,7 @@ from agent.translate.prompt import (
 from agent.translate.result import Attempt, TranslationResult
 from rsl.compiler import compile_program
 from rsl.diagnostics import Code, Diagnostic
-from rsl.plan import Quantity, format_number
+from rsl.plan import Plan, Quantity, format_number
 from rsl.profile import IDENTIFIER, Convention, Profile
 from rsl.syntax import NO_PROGRAM
 
@@ -59,6 +59,10 @@ _NOT_OBJECTS = frozenset({"left", "right", "start", "origin", "beginning", "way"
                           "little", "bit", "square", "triangle", "circle", "full", "long", "few", "couple",
                           "point", "position", "spot", "area", "room", "around", "head", "camera"})
 
+
+# The least probability the model must have given to ending a program early for that ending to be
+# tried when the whole program fails a meaning check (see Translator._shorter_ending).
+ENDING_FLOOR = 0.05
 
 _RANGE_CODES = frozenset({Code.OUT_OF_RANGE, Code.NOT_POSITIVE, Code.OUTSIDE_WORKSPACE})
 
@@ -110,6 +114,7 @@ class _ClauseState:
     lines: tuple[int, int] = (0, 0)
     timings: dict[str, float] = field(default_factory=dict)
     probabilities: tuple[float, ...] = ()  # the model's choices under the grammar, for the confidence
+    endings: tuple[tuple[int, int, float], ...] = ()  # see Generation.endings
 
 
 class Translator:
@@ -211,6 +216,7 @@ class Translator:
                 timings["generate"] += generation.generate_ms
                 state.program = _tidy(generation.text)
                 state.probabilities = generation.token_probabilities
+                state.endings = generation.endings
                 state.refused = self.options.refusal and state.program == NO_PROGRAM + "\n"
                 progress.debug("pass %d, clause %r -> %r (prompt %.0f ms, generation %.0f ms)", len(attempts) + 1,
                                state.clause.text, state.program.strip(), generation.prompt_ms,
@@ -237,18 +243,54 @@ class Translator:
         assert result is not None
         verified = attempts[-1].ok
         plan = result.plan if verified else None
+        program = attempts[-1].program
         judged = {}
         if plan is not None:
             checks_started = time.perf_counter()
-            judged = judge(normalized, plan, self.profile, (p for s in states for p in s.probabilities), known)
+            probabilities = tuple(p for s in states for p in s.probabilities)
+            if len(states) == 1 and assess(normalized, plan, self.profile, known_objects=known).doubts:
+                shorter = self._shorter_ending(states[0], normalized, known)
+                if shorter is not None:
+                    program, plan, probabilities = shorter
+            judged = judge(normalized, plan, self.profile, probabilities, known)
             timings["checks"] = (time.perf_counter() - checks_started) * 1000
         timings["total"] = (time.perf_counter() - started) * 1000
         progress.debug("%s after %d pass(es) in %.0f ms: prompt %.0f ms, generation %.0f ms, compile %.1f ms",
                        "verified" if verified else "NOT verified", len(attempts), timings["total"],
                        timings["prompt"], timings["generate"], timings["compile"])
-        return TranslationResult(task=task, program=attempts[-1].program, verified=verified,
+        return TranslationResult(task=task, program=program, verified=verified,
                                  passes=len(attempts), attempts=tuple(attempts),
                                  plan=plan, model=self.model_name, timings_ms=timings, **judged)
+
+    def _shorter_ending(self, state: _ClauseState, normalized: str, known: Collection[str] | None
+                        ) -> tuple[str, Plan, tuple[float, ...]] | None:
+        """The program without its last repetition, where the model weighed ending there and the checks pass.
+
+        A small model that repeats a step N times often writes it N + 1 times ("a square" with five
+        sides): it gave some probability to ending at the right place, and went on. When the whole plan
+        fails a meaning check, each place the model could have stopped (at least ENDING_FLOOR likely)
+        where what follows only repeats the statements just before it is tried, likeliest first. Only a
+        repeat is dropped: the checks bound totals from above, so they would let a cut that leaves out
+        a different step pass. The ending's probability joins the model's signal, so an ending the
+        model itself doubted still lowers the confidence and the person is asked.
+        """
+        lines = state.program.splitlines()
+        for count, chosen, probability in sorted(state.endings, key=lambda e: -e[2]):
+            dropped = len(lines) - count
+            if probability < ENDING_FLOOR or not 0 < dropped <= count:
+                continue
+            if lines[count:] != lines[count - dropped:count]:
+                continue
+            program = "".join(line + "\n" for line in lines[:count])
+            compiled = compile_program(program, self.profile, known)
+            if compiled.plan is None or not compiled.ok:
+                continue
+            if assess(normalized, compiled.plan, self.profile, known_objects=known).doubts:
+                continue
+            progress.debug("the checks found fault with the whole program; the model could also have ended "
+                           "after %d statement(s) (p=%.2f), and that passes them", count, probability)
+            return program, compiled.plan, (*state.probabilities[:chosen], probability)
+        return None
 
     def prompt_for(self, text: str, extra: str = "") -> str:
         """The prompt for one normalized clause; `extra` is repair feedback."""
