@@ -53,13 +53,16 @@ def main() -> int:
     parser.add_argument("--out", default="bench/results/confidence_suite.json")
     parser.add_argument("--adapter", default="default", metavar="PATH",
                         help="adapter GGUF to measure (default: the shipped one)")
+    parser.add_argument("--split", choices=("default", "on", "off"), default="default",
+                        help="clause splitting (default: the translator's default for the adapter)")
     parser.add_argument("--per-task", action="store_true",
                         help="also write each task's outcome (only for sets that may be looked at)")
     args = parser.parse_args()
 
     profile = load_profile()
     tasks = load_suite(args.suite, profile)[:: max(1, args.every)]
-    translator = Translator.load(profile, adapter=args.adapter)
+    translator = Translator.load(profile, adapter=args.adapter,
+                                 split_clauses={"default": None, "on": True, "off": False}[args.split])
     rows: list[dict[str, Any]] = []
     checks_ms: list[float] = []
     started = time.monotonic()
@@ -91,7 +94,8 @@ def main() -> int:
                       "accuracy": sum(r["right"] for r in kept) / len(kept) if kept else None})
     summary: dict[str, Any] = {
         "suite": str(args.suite or suite_path()),
-        "adapter": args.adapter,
+        "adapter": args.adapter, "split": args.split,
+        "accuracy": sum(r["right"] for r in rows) / items if items else None,
         "items": items, "tasks": len(real), "non_tasks": len(chat),
         "unsure_below": UNSURE_BELOW,
         "wrong_runs_unasked": sum(1 for r in wrong if not r["confirm"]) / items,

@@ -33,7 +33,7 @@ def register(subparsers: Any) -> None:
                         help="adapter GGUF to write; the card goes beside it as .json (default: the shipped "
                              "adapter for the built-in robot and model, else ./rsl-adapter.gguf)")
     parser.add_argument("--pairs", type=int, default=20000, metavar="N", help="training pairs (default 20000)")
-    parser.add_argument("--steps", type=int, default=400, metavar="N", help="optimizer steps (default 400)")
+    parser.add_argument("--steps", type=int, default=1000, metavar="N", help="optimizer steps (default 1000)")
     parser.add_argument("--batch", type=int, default=8, metavar="N", help="pairs per step (default 8)")
     parser.add_argument("--lr", type=float, default=3e-4, metavar="RATE", help="peak learning rate (3e-4)")
     parser.add_argument("--rank", type=int, default=16, metavar="R", help="LoRA rank (default 16)")
