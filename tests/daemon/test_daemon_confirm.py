@@ -16,9 +16,10 @@ from tests.daemon.conftest import Daemon, check_frame, follow
 
 TIMEOUT_S = 3.0
 TASK = "drive forward 0.3 meters"
-# The shipped adapter writes a base turn for it (a plan the meaning checks doubt: "you said not to move
-# the base"); if a retrained adapter gets it right, pick another phrase it gets wrong.
-UNSURE = "don't move, just look left"
+# Speech-recognizer noise for "turn right four times": the shipped adapter writes `turnright 4;` four
+# times, a plan the meaning checks doubt (an angle never said, 917 degrees in all); if a retrained adapter
+# gets it right, pick another phrase it gets wrong.
+UNSURE = "turn right for times"
 NOT_A_TASK = "thank you, that is all for today"
 
 
