@@ -74,5 +74,10 @@ def judge(task: str, plan: Plan, profile: Profile, probabilities: Iterable[float
           known_objects: Collection[str] | None = None) -> dict[str, Any]:
     """The fields a verified `TranslationResult` carries besides the plan: explanation, confidence, doubts."""
     assessment = assess(task, plan, profile, model=model_signal(probabilities), known_objects=known_objects)
+    return result_fields(plan, profile, assessment)
+
+
+def result_fields(plan: Plan, profile: Profile, assessment: Assessment) -> dict[str, Any]:
+    """`judge`'s fields for a plan already assessed."""
     return {"explanation": explain(plan, profile), "confidence": assessment.confidence,
             "doubts": assessment.reasons, "confirm": asks("unsure", assessment)}

@@ -23,7 +23,7 @@ from agent.adapter.card import AdapterCard, card_path, read_card
 from agent.normalize import normalize_task
 from agent.translate.automaton import RslAutomaton
 from agent.translate.clauses import Clause, split_clauses
-from agent.translate.confidence import assess, judge
+from agent.translate.confidence import assess, model_signal, result_fields
 from agent.translate.engine import CancelFlag, Generation
 from agent.translate.model_path import ModelNotFoundError
 from agent.translate.prompt import (
@@ -247,12 +247,15 @@ class Translator:
         judged = {}
         if plan is not None:
             checks_started = time.perf_counter()
-            probabilities = tuple(p for s in states for p in s.probabilities)
-            if len(states) == 1 and assess(normalized, plan, self.profile, known_objects=known).doubts:
+            model = model_signal(p for s in states for p in s.probabilities)
+            assessment = assess(normalized, plan, self.profile, model=model, known_objects=known)
+            if len(states) == 1 and assessment.doubts:
                 shorter = self._shorter_ending(states[0], normalized, known)
                 if shorter is not None:
                     program, plan, probabilities = shorter
-            judged = judge(normalized, plan, self.profile, probabilities, known)
+                    assessment = assess(normalized, plan, self.profile, model=model_signal(probabilities),
+                                        known_objects=known)
+            judged = result_fields(plan, self.profile, assessment)
             timings["checks"] = (time.perf_counter() - checks_started) * 1000
         timings["total"] = (time.perf_counter() - started) * 1000
         progress.debug("%s after %d pass(es) in %.0f ms: prompt %.0f ms, generation %.0f ms, compile %.1f ms",
