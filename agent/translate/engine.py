@@ -307,7 +307,8 @@ class LocalEngine:
                     finished = True
                     break
             else:
-                full = out.count(b";") >= automaton.max_statements  # type: ignore[union-attr]
+                statements = out.count(b";")
+                full = statements >= automaton.max_statements  # type: ignore[union-attr]
                 ids, states = masks.closing(state) if full else masks.at(state)
                 if len(ids) == 0:
                     break
@@ -317,7 +318,7 @@ class LocalEngine:
                 chosen.append(float(1.0 / weights.sum()))
                 ending = masks.ends(state)
                 if len(ending) and states[choice] != END:
-                    endings.append((out.count(b";"), len(chosen) - 1,
+                    endings.append((statements, len(chosen) - 1,
                                     float(weights[ending].sum() / weights.sum())))
                 token, state = int(ids[choice]), states[choice]
             out += pieces[token]
