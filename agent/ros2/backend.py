@@ -41,7 +41,6 @@ GOAL_GIVE_UP = 2.0  # s standing still short of a goal, after moving, before the
 JOINT_TOLERANCE = 0.01  # rad, or m for the gripper
 STILL_LINEAR = 0.01  # m/s; slower than this counts as standing still
 STILL_ANGULAR = 0.02  # rad/s
-DISCOVERY_WAIT = 3.0  # s to wait for a subscriber before calling a topic dead
 FIRST_MESSAGE_WAIT = 2.0  # s to wait for the first joint states or objects after connecting
 
 
@@ -456,7 +455,7 @@ class Ros2Robot(SkillCalls):
             raise _Cancelled("emergency stop")
 
     def _require_listener(self, count: Callable[[], int], topic: str) -> None:
-        deadline = time.monotonic() + DISCOVERY_WAIT
+        deadline = time.monotonic() + self._link.discovery_wait()
         while count() == 0:
             if time.monotonic() > deadline:
                 raise StepFailure(f"nobody subscribes to {topic}: the robot would not receive the command. "

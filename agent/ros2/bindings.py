@@ -22,7 +22,6 @@ from agent.robot import CancelToken, Outcome
 from agent.ros2.link import RobotLink
 from rsl.profile import Param, Profile, ProfileError, RosBinding, Source
 
-DISCOVERY_WAIT = 3.0  # s to wait for a subscriber before calling a topic dead
 JOINT_TOLERANCE = 0.01  # rad (or m): a joint this close to its target has arrived
 CONTROL_PERIOD = 0.02  # s between checks of the joint states
 
@@ -88,7 +87,7 @@ class BoundSkills:
         return self._await_joints(dict(zip(binding.joints, positions, strict=True)), binding.duration, token)
 
     def _await_listener(self, publisher: Any, topic: str) -> None:
-        deadline = time.monotonic() + DISCOVERY_WAIT
+        deadline = time.monotonic() + self._link.discovery_wait()
         while publisher.get_subscription_count() == 0:
             if time.monotonic() > deadline:
                 raise BindingFailure(f"nobody subscribes to {topic}: the robot would not receive the command. "

@@ -47,6 +47,9 @@ class RosConfig:
     odom_timeout: float = _seconds(0.5, "seconds without odometry before a moving base is stopped and the step fails")
     connect_timeout: float = _seconds(10.0, "seconds to wait for the robot's first odometry before giving up")
     service_timeout: float = _seconds(5.0, "seconds a primitive's service may take to answer")
+    discovery_timeout: float = _seconds(10.0, (
+        "seconds after the backend starts that DDS discovery may take to find a service or a topic's "
+        "subscriber before it is called missing; after that, 2 s"))
 
     @classmethod
     def from_profile(cls, profile: Profile) -> RosConfig:

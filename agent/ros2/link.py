@@ -20,6 +20,8 @@ from agent.ros2.messages import FormatError, ObjectReport, decode_objects
 from agent.ros2.node_thread import NodeThread
 from rsl.profile import PRIMITIVES, Primitive, Profile
 
+DISCOVERY_FLOOR = 2.0  # s a long-running backend still waits for a service or subscriber
+
 
 @dataclass(frozen=True)
 class Odometry:
@@ -51,6 +53,7 @@ class RobotLink:
         from trajectory_msgs.msg import JointTrajectory
 
         self.config = config
+        self._started = time.monotonic()
         self._closed = False
         self._lock = threading.Lock()
         self._odom_arrived = threading.Condition(self._lock)
@@ -222,7 +225,7 @@ class RobotLink:
     def call(self, client: object, name: str, cancel: CancelToken, request: object | None = None) -> ServiceReply:
         """Call a service whose response has `success` and `message` (std_srvs Trigger, SetBool)."""
         timeout = self.config.service_timeout
-        if not client.wait_for_service(timeout_sec=min(timeout, 2.0)):  # type: ignore[attr-defined]
+        if not client.wait_for_service(timeout_sec=self.discovery_wait()):  # type: ignore[attr-defined]
             raise ServiceError(f"service {name} is not available; is the robot's driver "
                                "(or `nrtrans sim-bridge`) running and offering it?")
         future = client.call_async(request or self._trigger_request())  # type: ignore[attr-defined]
@@ -237,6 +240,15 @@ class RobotLink:
                 raise ServiceError(f"service {name} did not answer within {timeout:g} s")
         response = future.result()
         return ServiceReply(bool(response.success), str(response.message))
+
+    def discovery_wait(self) -> float:
+        """Seconds to wait for a service or a subscriber to be discovered before calling it missing.
+
+        Discovery on a loaded two-core machine has taken over 2 s, so a backend just started is
+        given the whole discovery timeout; one that has run longer has seen the graph already.
+        """
+        left = self.config.discovery_timeout - (time.monotonic() - self._started)
+        return max(DISCOVERY_FLOOR, left)
 
     def listeners(self, publisher: str) -> int:
         """How many subscriptions match one of our publishers: cmd_vel, goal, head or gripper."""

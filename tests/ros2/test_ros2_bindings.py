@@ -173,6 +173,43 @@ def test_a_service_that_refuses_fails_the_step_with_its_reason(
     assert outcome.reason == "/dock refused: no dock in sight"
 
 
+def test_a_service_discovered_seconds_after_start_still_answers(
+        renamed_bridge: tuple[Bridge, Path], probe: Probe) -> None:
+    """On CI's two loaded cores a just-started backend once took over 2 s to discover /dock
+    and failed the step; DDS discovery is that slow there, so the backend must wait for it."""
+    from std_srvs.srv import Trigger
+
+    from rsl.profile import parse_profile
+    from tests.bindings.skills import profile_text
+
+    late_name = "/late/dock"
+    profile = parse_profile(profile_text().replace(f'service = "{DOCK_SERVICE}"', f'service = "{late_name}"'),
+                            source="late.toml")
+    late: list[NodeThread] = []
+
+    def offer_late() -> None:
+        ros = NodeThread("nrtrans_test_late_dock")
+        ros.node.create_service(Trigger, late_name, lambda _req, res: _answered(res, "docked late"))
+        late.append(ros)
+
+    try:
+        with Ros2Robot(profile, connect_timeout=30.0) as robot:
+            timer = threading.Timer(3.0, offer_late)
+            timer.start()
+            outcome = robot.dock(cancel=CancelToken())  # type: ignore[attr-defined]
+            timer.join()
+    finally:
+        for ros in late:
+            ros.close()
+    assert outcome.ok, outcome.reason
+    assert outcome.reason == f"{late_name}: docked late"
+
+
+def _answered(response: Any, message: str) -> Any:
+    response.success, response.message = True, message
+    return response
+
+
 class Dock:
     """The base-only robot's dock services, on its own names."""
 

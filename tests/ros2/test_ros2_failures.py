@@ -168,7 +168,8 @@ def test_a_missing_service_fails_the_step_instead_of_hanging(bridge: Bridge, pro
         outcome = robot.perceive()
     assert outcome.status is Status.FAILED
     assert "service /nobody/perceive is not available" in outcome.reason
-    assert time.monotonic() - started < 5.0
+    # Bounded by discovery's allowance after start-up, not by the service's answer time.
+    assert time.monotonic() - started < config.discovery_timeout + 1.0
 
 
 def test_a_goal_the_robot_settles_short_of_fails_without_waiting_for_the_timeout(
