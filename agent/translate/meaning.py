@@ -300,13 +300,24 @@ def _totals(text: str, plan: Plan, vocab: _Vocabulary) -> list[Doubt]:
         if planned == 0:
             continue
         said_total = sum(v for v, u in said if u == unit)
+        counted = said_total > 0 and _COUNT.search(text) is not None
         if said_total == 0:
             said_total = _vague_amount(text, vocab, unit)
         limit = said_total * count
-        if planned > max(limit, 2 * math.pi if unit == "rad" else 0.0) * 1.01 + _TOLERANCE:
+        # Without a said count and amount a turn may fairly come out as up to a full circle
+        # ("spin around"); with both, one repetition too many is what goes wrong.
+        floor = 2 * math.pi if unit == "rad" and not counted else 0.0
+        if counted:
+            limit += _conventions_said(text, vocab, unit)
+        if planned > max(limit, floor) * 1.01 + _TOLERANCE:
             doubts.append(Doubt("total", f"you said {quantity(Quantity(limit, unit))} of {noun} in all, "
                                          f"but the plan {verb} {quantity(Quantity(planned, unit))}"))
     return doubts
+
+
+def _conventions_said(text: str, vocab: _Vocabulary, unit: str) -> float:
+    """What the conventions named in the task add ("then turn around": 180°)."""
+    return sum(max(values.get(unit, (0.0,))) for phrase, values, _default in vocab.amounts if phrase in text)
 
 
 def _vague_amount(text: str, vocab: _Vocabulary, unit: str) -> float:

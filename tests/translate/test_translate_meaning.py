@@ -71,6 +71,8 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
     ("drive forward 2 meters", "forward 3;", "you said 2 m, but the plan never uses it"),
     ("move the head right, then forward 0.3 meters", "approach right; forward 0.3;",
      "the plan takes 'right' for an object, but it names a direction or an action"),
+    # A count said with an amount bounds the turn exactly, even below a full circle: one repetition too many.
+    ("turn left 0.5 radians 4 times", "turnleft 0.5; " * 5, "you said 115° of turn in all, but the plan turns 143°"),
 ])
 def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str, expected: str,
                                                          profile: Profile) -> None:
@@ -89,6 +91,9 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     ("look left", "lookleft 0.5236;"),
     ("turn around", "turnleft 3.1416;"),
     ("turn left 90 degrees 3 times", "turnleft 1.5708; turnleft 1.5708; turnleft 1.5708;"),
+    ("turn left 0.5 radians 4 times", "turnleft 0.5; " * 4),
+    ("turn left 90 degrees twice, then turn around", "turnleft 1.5708; turnleft 1.5708; turnleft 3.1416;"),
+    ("turn left 45 degrees and do that 8 times", "turnleft 0.7854; " * 8),
     ("approach the table and pick up the cup", "approach table; grasp cup;"),
     ("back up 0.7 meters", "backward 0.7;"),
     ("look around and then find the keys",
