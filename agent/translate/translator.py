@@ -23,7 +23,7 @@ from agent.adapter.card import AdapterCard, card_path, read_card
 from agent.normalize import normalize_task
 from agent.translate.automaton import RslAutomaton
 from agent.translate.clauses import Clause, split_clauses
-from agent.translate.confidence import assess, model_signal, result_fields
+from agent.translate.confidence import Assessment, assess, model_signal, result_fields
 from agent.translate.engine import CancelFlag, Generation
 from agent.translate.model_path import ModelNotFoundError
 from agent.translate.prompt import (
@@ -252,9 +252,7 @@ class Translator:
             if len(states) == 1 and assessment.doubts:
                 shorter = self._shorter_ending(states[0], normalized, known)
                 if shorter is not None:
-                    program, plan, probabilities = shorter
-                    assessment = assess(normalized, plan, self.profile, model=model_signal(probabilities),
-                                        known_objects=known)
+                    program, plan, _probabilities, assessment = shorter
             judged = result_fields(plan, self.profile, assessment)
             timings["checks"] = (time.perf_counter() - checks_started) * 1000
         timings["total"] = (time.perf_counter() - started) * 1000
@@ -266,7 +264,7 @@ class Translator:
                                  plan=plan, model=self.model_name, timings_ms=timings, **judged)
 
     def _shorter_ending(self, state: _ClauseState, normalized: str, known: Collection[str] | None
-                        ) -> tuple[str, Plan, tuple[float, ...]] | None:
+                        ) -> tuple[str, Plan, tuple[float, ...], Assessment] | None:
         """The program without its last repetition, where the model weighed ending there and the checks pass.
 
         A small model that repeats a step N times often writes it N + 1 times ("a square" with five
@@ -275,7 +273,8 @@ class Translator:
         where what follows only repeats the statements just before it is tried, likeliest first. Only a
         repeat is dropped: the checks bound totals from above, so they would let a cut that leaves out
         a different step pass. The ending's probability joins the model's signal, so an ending the
-        model itself doubted still lowers the confidence and the person is asked.
+        model itself doubted still lowers the confidence and the person is asked. The chosen ending comes
+        back with its assessment, so the checks run once on it.
         """
         lines = state.program.splitlines()
         for count, chosen, probability in sorted(state.endings, key=lambda e: -e[2]):
@@ -288,11 +287,14 @@ class Translator:
             compiled = compile_program(program, self.profile, known)
             if compiled.plan is None or not compiled.ok:
                 continue
-            if assess(normalized, compiled.plan, self.profile, known_objects=known).doubts:
+            probabilities = (*state.probabilities[:chosen], probability)
+            assessment = assess(normalized, compiled.plan, self.profile, model=model_signal(probabilities),
+                                known_objects=known)
+            if assessment.doubts:
                 continue
             progress.debug("the checks found fault with the whole program; the model could also have ended "
                            "after %d statement(s) (p=%.2f), and that passes them", count, probability)
-            return program, compiled.plan, (*state.probabilities[:chosen], probability)
+            return program, compiled.plan, probabilities, assessment
         return None
 
     def prompt_for(self, text: str, extra: str = "") -> str:

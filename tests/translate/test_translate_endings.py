@@ -40,7 +40,7 @@ def test_a_failed_check_takes_the_likely_earlier_ending_that_passes(translator: 
     state = _square_state(sides=5, ending_after=8, probability=0.3)
     found = translator._shorter_ending(state, state.clause.text, None)
     assert found is not None
-    program, plan, probabilities = found
+    program, plan, probabilities, _assessment = found
     assert program == SQUARE_SIDE * 4 and len(plan) == 8
     # The ending's own probability is part of the model's signal, so the plan is not more trusted than it.
     assert probabilities[-1] == 0.3 and len(probabilities) == 5 * 8 + 1
