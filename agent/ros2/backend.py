@@ -455,12 +455,9 @@ class Ros2Robot(SkillCalls):
             raise _Cancelled("emergency stop")
 
     def _require_listener(self, count: Callable[[], int], topic: str) -> None:
-        deadline = time.monotonic() + self._link.discovery_wait()
-        while count() == 0:
-            if time.monotonic() > deadline:
-                raise StepFailure(f"nobody subscribes to {topic}: the robot would not receive the command. "
-                                  "Is its controller running and is the topic name in the profile right?")
-            time.sleep(0.05)
+        if not self._link.await_subscriber(count):
+            raise StepFailure(f"nobody subscribes to {topic}: the robot would not receive the command. "
+                              "Is its controller running and is the topic name in the profile right?")
 
     def _object_position(self, name: str, token: CancelToken) -> tuple[float, float]:
         found, error = self._lookup_object(name)

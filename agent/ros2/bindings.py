@@ -87,12 +87,9 @@ class BoundSkills:
         return self._await_joints(dict(zip(binding.joints, positions, strict=True)), binding.duration, token)
 
     def _await_listener(self, publisher: Any, topic: str) -> None:
-        deadline = time.monotonic() + self._link.discovery_wait()
-        while publisher.get_subscription_count() == 0:
-            if time.monotonic() > deadline:
-                raise BindingFailure(f"nobody subscribes to {topic}: the robot would not receive the command. "
-                                     "Is its controller running and is the name in the skill's binding right?")
-            time.sleep(0.05)
+        if not self._link.await_subscriber(publisher.get_subscription_count):
+            raise BindingFailure(f"nobody subscribes to {topic}: the robot would not receive the command. "
+                                 "Is its controller running and is the name in the skill's binding right?")
 
     def _await_joints(self, targets: dict[str, float], duration: float, token: CancelToken) -> Outcome:
         """Wait for the joints to arrive when joint_states reports them; otherwise for the duration."""

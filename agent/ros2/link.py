@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -249,6 +250,15 @@ class RobotLink:
         """
         left = self.config.discovery_timeout - (time.monotonic() - self._started)
         return max(DISCOVERY_FLOOR, left)
+
+    def await_subscriber(self, count: Callable[[], int]) -> bool:
+        """Wait, up to `discovery_wait`, until `count` (a publisher's subscriptions) is above 0; whether it was."""
+        deadline = time.monotonic() + self.discovery_wait()
+        while count() == 0:
+            if time.monotonic() > deadline:
+                return False
+            time.sleep(0.05)
+        return True
 
     def listeners(self, publisher: str) -> int:
         """How many subscriptions match one of our publishers: cmd_vel, goal, head or gripper."""
