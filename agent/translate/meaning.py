@@ -315,14 +315,19 @@ def _totals(text: str, plan: Plan, vocab: _Vocabulary) -> list[Doubt]:
     return doubts
 
 
+def _named_amounts(text: str, vocab: _Vocabulary) -> list[dict[str, frozenset[float]]]:
+    """The amounts of the conventions the task names, one per convention."""
+    return [values for phrase, values, _default in vocab.amounts if phrase in text]
+
+
 def _conventions_said(text: str, vocab: _Vocabulary, unit: str) -> float:
     """What the conventions named in the task add ("then turn around": 180°)."""
-    return sum(max(values.get(unit, (0.0,))) for phrase, values, _default in vocab.amounts if phrase in text)
+    return sum(max(values.get(unit, (0.0,))) for values in _named_amounts(text, vocab))
 
 
 def _vague_amount(text: str, vocab: _Vocabulary, unit: str) -> float:
     """The most a task that says no number may mean: its conventions' amounts, else the defaults'."""
-    used = [values for phrase, values, _default in vocab.amounts if phrase in text]
+    used = _named_amounts(text, vocab)
     if not used:
         used = [values for _phrase, values, default in vocab.amounts if default]
     return max((v for values in used for v in values.get(unit, ())), default=0.0)
