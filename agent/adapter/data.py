@@ -20,7 +20,7 @@ import re
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
-from agent.adapter.prompt import adapter_prompt
+from agent.adapter.prompt import adapter_prompt, program_objects
 from agent.normalize import normalize_task
 from rsl.plan import Command, ObjectRef, Plan, Quantity, format_number
 from rsl.profile import Convention, Profile, Skill
@@ -341,12 +341,6 @@ def _parse_program(text: str, profile: Profile) -> list[Command] | None:
     return None if plan is None else list(plan)
 
 
-def _program_objects(program: str, profile: Profile) -> list[str]:
-    """The object names a convention's example program passes ("approach cup; grasp cup;" -> cup)."""
-    return [arg.name for command in _parse_program(program, profile) or () for arg in command.args
-            if isinstance(arg, ObjectRef)]
-
-
 @dataclass(frozen=True)
 class Clause:
     text: str
@@ -514,7 +508,7 @@ class Generator:
     def whole_convention(self) -> Clause | None:
         if not self.whole:
             return None
-        plain = [c for c in self.whole if not _program_objects(c.program, self.profile)]
+        plain = [c for c in self.whole if not program_objects(c.program, self.profile)]
         if not plain:
             return None
         convention = self.rng.choice(plain)
@@ -695,11 +689,11 @@ class Generator:
 
     def activity(self) -> Clause | None:
         """A whole-command convention about an object ("go get the mug"), with the object varied."""
-        named = [c for c in self.whole if _program_objects(c.program, self.profile)]
+        named = [c for c in self.whole if program_objects(c.program, self.profile)]
         if not named:
             return None
         convention = self.rng.choice(named)
-        old = _program_objects(convention.program, self.profile)[0]
+        old = program_objects(convention.program, self.profile)[0]
         obj = self.rng.choice(OBJECTS)
         text = re.sub(rf"\b{re.escape(old)}\b", obj, convention.task)
         if self.rng.random() < 0.3:

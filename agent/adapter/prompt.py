@@ -14,6 +14,8 @@ from importlib import resources
 from pathlib import Path
 
 from agent.normalize import normalize_task
+from rsl.compiler import compile_program
+from rsl.plan import ObjectRef
 from rsl.profile import Profile
 
 # Bumped whenever the prompt text changes; the adapter card records it and the
@@ -52,19 +54,17 @@ def convention_notes(normalized_task: str, profile: Profile) -> list[str]:
             continue  # the normalizer already writes it as a number ("a full circle" -> "6.2832 rad")
         if not phrase or not re.search(rf"\b{re.escape(phrase)}\b", normalized_task):
             continue
-        as_program = convention.whole_command and not _names_object(convention.program, profile)
+        as_program = convention.whole_command and not program_objects(convention.program, profile)
         meaning = " ".join(convention.program.split()) if as_program else convention.meaning
         notes.append(f"{phrase} = {meaning}")
     return notes
 
 
-def _names_object(program: str, profile: Profile) -> bool:
-    """Whether a convention's program passes an object to a skill ("grasp cup;")."""
-    for statement in program.split(";"):
-        skill = profile.skill(statement.split()[0]) if statement.split() else None
-        if skill is not None and any(p.kind == "object" for p in skill.params):
-            return True
-    return False
+def program_objects(program: str, profile: Profile) -> list[str]:
+    """The object names a convention's example program passes ("approach cup; grasp cup;" -> cup), read
+    by the compiler."""
+    plan = compile_program(program, profile).plan
+    return [arg.name for command in plan or () for arg in command.args if isinstance(arg, ObjectRef)]
 
 
 def adapter_prompt(normalized_task: str, profile: Profile) -> str:
