@@ -20,6 +20,7 @@ from typing import Any
 from agent.adapter.data import Pair
 from agent.adapter.export import gguf_tensor_name, write_lora_gguf
 from agent.adapter.prompt import training_text
+from agent.adapter.recipe import Recipe
 
 TARGET_MODULES = ("q_proj", "k_proj", "v_proj", "o_proj", "gate_proj", "up_proj", "down_proj")
 MAX_TOKENS = 192
@@ -27,23 +28,6 @@ MAX_TOKENS = 192
 
 class TrainingError(RuntimeError):
     """Training cannot start or go on; the message says what to do."""
-
-
-@dataclass(frozen=True)
-class Recipe:
-    steps: int = 600
-    batch: int = 8
-    learning_rate: float = 3e-4
-    warmup: int = 20
-    rank: int = 16
-    alpha: float = 32.0
-    seed: int = 0
-    threads: int = 0  # 0: every core
-    # The frozen base runs in bfloat16 (about 10x faster on CPUs with AMX or
-    # AVX512-BF16, the same on GPUs); the LoRA weights stay float32.
-    bf16: bool = True
-    # Also write the adapter every this many steps (`<out>.step<N>.gguf`), for a learning curve; 0: never.
-    checkpoint_every: int = 0
 
 
 @dataclass(frozen=True)

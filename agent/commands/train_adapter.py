@@ -12,7 +12,10 @@ import time
 from pathlib import Path
 from typing import Any
 
+from agent.adapter.recipe import Recipe
+
 EXIT_USAGE = 2
+DEFAULTS = Recipe()
 
 
 def register(subparsers: Any) -> None:
@@ -32,13 +35,19 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--out", metavar="FILE",
                         help="adapter GGUF to write; the card goes beside it as .json (default: the shipped "
                              "adapter for the built-in robot and model, else ./rsl-adapter.gguf)")
-    parser.add_argument("--pairs", type=int, default=20000, metavar="N", help="training pairs (default 20000)")
-    parser.add_argument("--steps", type=int, default=1000, metavar="N", help="optimizer steps (default 1000)")
-    parser.add_argument("--batch", type=int, default=8, metavar="N", help="pairs per step (default 8)")
-    parser.add_argument("--lr", type=float, default=3e-4, metavar="RATE", help="peak learning rate (3e-4)")
-    parser.add_argument("--rank", type=int, default=16, metavar="R", help="LoRA rank (default 16)")
-    parser.add_argument("--seed", type=int, default=0, help="seed for data, order and weights (default 0)")
-    parser.add_argument("--threads", type=int, default=0, metavar="N",
+    parser.add_argument("--pairs", type=int, default=DEFAULTS.pairs, metavar="N",
+                        help=f"training pairs (default {DEFAULTS.pairs})")
+    parser.add_argument("--steps", type=int, default=DEFAULTS.steps, metavar="N",
+                        help=f"optimizer steps (default {DEFAULTS.steps})")
+    parser.add_argument("--batch", type=int, default=DEFAULTS.batch, metavar="N",
+                        help=f"pairs per step (default {DEFAULTS.batch})")
+    parser.add_argument("--lr", type=float, default=DEFAULTS.learning_rate, metavar="RATE",
+                        help=f"peak learning rate (default {DEFAULTS.learning_rate:g})")
+    parser.add_argument("--rank", type=int, default=DEFAULTS.rank, metavar="R",
+                        help=f"LoRA rank (default {DEFAULTS.rank}; alpha is twice the rank)")
+    parser.add_argument("--seed", type=int, default=DEFAULTS.seed,
+                        help=f"seed for data, order and weights (default {DEFAULTS.seed})")
+    parser.add_argument("--threads", type=int, default=DEFAULTS.threads, metavar="N",
                         help="CPU threads for training (default: every core when the machine is idle, one "
                              "when it is busy; on a CPU shared with other work, one thread was several times "
                              "faster than two that wait for each other)")
@@ -69,7 +78,7 @@ def _train(args: argparse.Namespace) -> int:
     from agent.adapter.data import generate
     from agent.adapter.hygiene import eval_tasks, held_out_filter
     from agent.adapter.prompt import DEFAULT_ADAPTER, PROMPT_VERSION
-    from agent.adapter.train import Recipe, TrainingError, require_train_extra, train
+    from agent.adapter.train import TrainingError, require_train_extra, train
     from agent.translate import ModelNotFoundError
     from agent.translate.model_path import resolve_model
     from rsl.profile import ProfileError, load_profile
@@ -104,9 +113,9 @@ def _train(args: argparse.Namespace) -> int:
     threads = args.threads or _auto_threads()
     print(f"training with {threads} CPU thread(s)", file=sys.stderr)
 
-    recipe = Recipe(steps=args.steps, batch=args.batch, learning_rate=args.lr, rank=args.rank,
-                    alpha=2.0 * args.rank, seed=args.seed, threads=threads,
-                    checkpoint_every=args.checkpoint_every)
+    recipe = dataclasses.replace(DEFAULTS, pairs=args.pairs, steps=args.steps, batch=args.batch,
+                                 learning_rate=args.lr, rank=args.rank, alpha=2.0 * args.rank, seed=args.seed,
+                                 threads=threads, checkpoint_every=args.checkpoint_every)
     base_sha = sha256_of(base)
     try:
         result = train(pairs, base, out, recipe, metadata={

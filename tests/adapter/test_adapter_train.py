@@ -8,7 +8,8 @@ from pathlib import Path
 from agent.adapter.card import read_card
 from agent.adapter.data import generate
 from agent.adapter.evaluate import complete, load
-from agent.adapter.train import Recipe, train
+from agent.adapter.recipe import Recipe
+from agent.adapter.train import train
 from rsl.profile import Profile
 from tests.adapter.conftest import requires
 
