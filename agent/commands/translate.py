@@ -31,12 +31,13 @@ def add_model_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-prefix-shots", action="store_true",
                         help="leave the worked examples out of the fixed, KV-cached prompt prefix "
                              "(then use --shots N to pick similar ones per clause)")
-    parser.add_argument("--no-split", action="store_true",
-                        help="translate the task in one go instead of clause by clause (the default with the "
-                             "adapter)")
-    parser.add_argument("--split", action="store_true",
-                        help="split the task into clauses and translate them one by one (the default without "
-                             "the adapter)")
+    clauses = parser.add_mutually_exclusive_group()
+    clauses.add_argument("--no-split", action="store_true",
+                         help="translate the task in one go instead of clause by clause (the default with the "
+                              "adapter)")
+    clauses.add_argument("--split", action="store_true",
+                         help="split the task into clauses and translate them one by one (the default "
+                              "without the adapter)")
     parser.add_argument("--no-narrow", action="store_true",
                         help="do not narrow the grammar to the objects and numbers the task mentions")
     parser.add_argument("--profile", metavar="FILE", help="robot profile TOML (default: the built-in robot)")

@@ -55,6 +55,7 @@ def test_exit_one_and_last_attempt_shown_when_not_verified(model_path: Path) -> 
         (["--max-passes", "0", "turn left"], "--max-passes must be at least 1"),
         (["   "], "the task is empty"),
         (["--endpoint", "ftp://example", "turn left"], "not an http(s) URL"),
+        (["--split", "--no-split", "turn left"], "not allowed with argument"),
     ],
 )
 def test_bad_input_gets_a_clear_error_and_exit_two(args: list[str], message: str) -> None:
