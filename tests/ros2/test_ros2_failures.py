@@ -172,6 +172,20 @@ def test_a_missing_service_fails_the_step_instead_of_hanging(bridge: Bridge, pro
     assert time.monotonic() - started < config.discovery_timeout + 1.0
 
 
+def test_a_drive_nobody_listens_to_fails_the_step_and_says_which_topic(bridge: Bridge, probe: Probe,
+                                                                       profile: Profile) -> None:
+    probe.reset_world()
+    config = dataclasses.replace(RosConfig.from_profile(profile), cmd_vel="/nobody/cmd_vel")
+    with Ros2Robot(profile, config=config, connect_timeout=30.0) as robot:
+        started = time.monotonic()
+        outcome = robot.forward(0.5)
+    assert outcome.status is Status.FAILED
+    assert "nobody subscribes to /nobody/cmd_vel" in outcome.reason
+    assert "controller running" in outcome.reason
+    assert time.monotonic() - started < config.discovery_timeout + 1.0
+    assert all(t.linear == 0.0 and t.angular == 0.0 for t in probe.twists), "the real base was commanded"
+
+
 def test_a_goal_the_robot_settles_short_of_fails_without_waiting_for_the_timeout(
         bridge: Bridge, probe: Probe, profile: Profile) -> None:
     # The bridge's follower settles within 1 cm; a profile demanding 1 mm stands for a
