@@ -280,7 +280,11 @@ def _numbers(text: str, plan: Plan, vocab: _Vocabulary, profile: Profile) -> lis
         said_here = [v for v, u in said if not u or u == unit]
         if any(_close(value, v * k) for v in said_here for k in range(1, count + 1)):
             continue
-        if not said_here and any(_close(value, v) for v in vocab.convention_numbers.get(unit, ())):
+        # More steps in this unit than amounts said (repetitions aside): some step was said without
+        # one, and a convention's amount (the default) stands in for it.
+        steps = sum(1 for _v, u, _c in amounts if u == unit)
+        unsaid = steps > len(said_here) * count
+        if (unsaid or not said_here) and any(_close(value, v) for v in vocab.convention_numbers.get(unit, ())):
             continue
         if unit == "rad" and any(_close(value, t) for t in shape_turns):
             continue

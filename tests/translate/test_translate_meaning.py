@@ -73,6 +73,10 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
      "the plan takes 'right' for an object, but it names a direction or an action"),
     # A count said with an amount bounds the turn exactly, even below a full circle: one repetition too many.
     ("turn left 0.5 radians 4 times", "turnleft 0.5; " * 5, "you said 115° of turn in all, but the plan turns 143°"),
+    # Every step had its amount said, so a default in their place was not said.
+    ("turn left 45 degrees 4 times", "turnleft 1.5708; " * 4, "you said 180° of turn in all, but the plan turns 360°"),
+    ("look up 20 degrees and turn left 45 degrees", "lookup 0.5236; turnleft 0.7854;",
+     "the plan uses 30° (look up 30°), which you did not say"),
 ])
 def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str, expected: str,
                                                          profile: Profile) -> None:
@@ -98,6 +102,9 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     ("back up 0.7 meters", "backward 0.7;"),
     ("look around and then find the keys",
      "lookleft 1.5708; perceive; lookright 3.1416; perceive; lookleft 1.5708; perceive;"),
+    # A step said without an amount takes its default even where another step's amount was said.
+    ("turn right ninety degrees then look left", "turnright 1.5708; lookleft 0.5236;"),
+    ("drive forward 2 meters and turn left", "forward 2; turnleft 1.5708;"),
 ])
 def test_a_plan_that_does_what_was_said_has_no_doubt(task: str, program: str, profile: Profile) -> None:
     assert reasons(task, program, profile, ["cup", "table", "keys"]) == []
