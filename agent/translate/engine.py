@@ -54,6 +54,23 @@ class Generation:
     # Where the model could have ended the program but went on: (statements written so far, how many
     # tokens were chosen before that point, the probability it gave to ending there).
     endings: tuple[tuple[int, int, float], ...] = ()
+    # The tokens chosen, and where the grammar's runner-up was likely (at least FORK_RECORD_FLOOR): (how
+    # many tokens were chosen before that point, the runner-up, its probability). A Fork starts there.
+    tokens: tuple[int, ...] = ()
+    forks: tuple[tuple[int, int, float], ...] = ()
+
+
+@dataclass(frozen=True)
+class Fork:
+    """Generate again from a place in an earlier generation, taking another token there: the tokens
+    chosen before it and their probabilities (kept for the model's signal), then `token`."""
+    tokens: tuple[int, ...]
+    probabilities: tuple[float, ...]
+    token: int
+
+
+# Runner-ups less likely than this are not worth a generation, so they are not recorded.
+FORK_RECORD_FLOOR = 0.05
 
 
 def use_plain_cpu_buffers() -> None:
@@ -234,10 +251,15 @@ class LocalEngine:
         return masks
 
     def generate(self, prompt: str, automaton: RslAutomaton | None, max_tokens: int,
-                 cancel: CancelFlag | None = None) -> Generation:
-        """Raises `GenerationCancelled` within milliseconds of `cancel` being set, even mid-token."""
+                 cancel: CancelFlag | None = None, fork: Fork | None = None) -> Generation:
+        """Raises `GenerationCancelled` within milliseconds of `cancel` being set, even mid-token.
+
+        With `fork` (which needs the grammar) the output starts with the fork's tokens and its other
+        token, and goes on greedily from there; the KV cache of the earlier generation is reused."""
+        if fork is not None and automaton is None:
+            raise ValueError("a fork follows the grammar's states; it needs an automaton")
         if cancel is None:
-            return self._generate(prompt, automaton, max_tokens)
+            return self._generate(prompt, automaton, max_tokens, fork)
         if cancel.is_set():
             raise GenerationCancelled("generation cancelled")
         done = threading.Event()
@@ -252,7 +274,7 @@ class LocalEngine:
         watcher = threading.Thread(target=watch, name="nrtrans-cancel-watch", daemon=True)
         watcher.start()
         try:
-            return self._generate(prompt, automaton, max_tokens)
+            return self._generate(prompt, automaton, max_tokens, fork)
         except RuntimeError:
             if self._abort.is_set():
                 raise GenerationCancelled("generation cancelled") from None
@@ -262,7 +284,8 @@ class LocalEngine:
             watcher.join()
             self._abort.clear()
 
-    def _generate(self, prompt: str, automaton: RslAutomaton | None, max_tokens: int) -> Generation:
+    def _generate(self, prompt: str, automaton: RslAutomaton | None, max_tokens: int,
+                  fork: Fork | None = None) -> Generation:
         import llama_cpp
 
         def check() -> None:
@@ -275,13 +298,18 @@ class LocalEngine:
         if len(tokens) + max_tokens > llm.n_ctx():
             raise ValueError(f"the prompt is {len(tokens)} tokens; with {max_tokens} to generate it does not "
                              f"fit the context of {llm.n_ctx()}. Shorten the task.")
+        # A fork's tokens before its other choice were evaluated by the earlier generation: only the
+        # cache is checked for them, and they are replayed through the grammar without new logits.
+        replayed = list(fork.tokens) if fork is not None else []
+        forced = [*replayed, fork.token] if fork is not None else []
+        feed = tokens + replayed
         reused = 0
         cached = llm.input_ids[:llm.n_tokens]
-        limit = min(len(cached), len(tokens) - 1)
-        while reused < limit and cached[reused] == tokens[reused]:
+        limit = min(len(cached), len(feed) - 1)
+        while reused < limit and cached[reused] == feed[reused]:
             reused += 1
         llm.n_tokens = reused
-        llm.eval(tokens[reused:])
+        llm.eval(feed[reused:])
         prompt_done = time.perf_counter()
 
         n_vocab = llm.n_vocab()
@@ -292,12 +320,17 @@ class LocalEngine:
         finished = False
         pieces = self.vocabulary.pieces
         first_piece, first_probability = "", 0.0
-        chosen: list[float] = []
+        chosen: list[float] = list(fork.probabilities) if fork is not None else []
         endings: list[tuple[int, int, float]] = []
+        picked: list[int] = []
+        forks: list[tuple[int, int, float]] = []
         while generated < max_tokens:
             check()
-            logits = np.ctypeslib.as_array(llama_cpp.llama_get_logits_ith(llm._ctx.ctx, -1), shape=(n_vocab,))
-            if generated == 0:
+            replay = generated < len(replayed)
+            if not replay:
+                logits = np.ctypeslib.as_array(llama_cpp.llama_get_logits_ith(llm._ctx.ctx, -1),
+                                               shape=(n_vocab,))
+            if generated == 0 and not replay:
                 top = int(np.argmax(logits))
                 first_probability = float(1.0 / np.exp(logits - logits[top]).sum())
                 first_piece = pieces[top].decode("utf-8", errors="replace")
@@ -312,21 +345,37 @@ class LocalEngine:
                 ids, states = masks.closing(state) if full else masks.at(state)
                 if len(ids) == 0:
                     break
-                allowed = logits[ids]
-                choice = int(np.argmax(allowed))
-                weights = np.exp(allowed - allowed[choice])
-                chosen.append(float(1.0 / weights.sum()))
-                ending = masks.ends(state)
-                if len(ending) and states[choice] != END:
-                    endings.append((statements, len(chosen) - 1,
-                                    float(weights[ending].sum() / weights.sum())))
+                if generated < len(forced):
+                    hits = np.flatnonzero(ids == forced[generated])
+                    if not len(hits):
+                        raise ValueError(f"the fork's token {forced[generated]} is not allowed by the grammar "
+                                         f"after {out.decode('utf-8', errors='replace')!r}")
+                    choice = int(hits[0])
+                if not replay:
+                    allowed = logits[ids]
+                    if generated >= len(forced):
+                        choice = int(np.argmax(allowed))
+                    weights = np.exp(allowed - allowed.max())
+                    total = float(weights.sum())
+                    chosen.append(float(weights[choice] / total))
+                    ending = masks.ends(state)
+                    if len(ending) and states[choice] != END:
+                        endings.append((statements, len(chosen) - 1, float(weights[ending].sum() / total)))
+                    if len(ids) > 1 and generated >= len(forced):
+                        others = weights.copy()
+                        others[choice] = 0.0
+                        second = int(np.argmax(others))
+                        if others[second] / total >= FORK_RECORD_FLOOR and states[second] != END:
+                            forks.append((len(chosen) - 1, int(ids[second]), float(others[second] / total)))
                 token, state = int(ids[choice]), states[choice]
             out += pieces[token]
+            picked.append(token)
             generated += 1
             if state == END or (masks is None and b"\n\n" in out):
                 finished = True
                 break
-            llm.eval([token])
+            if not replay:
+                llm.eval([token])
         text = out.decode("utf-8", errors="replace")
         if masks is None and "\n\n" in text:
             text = text[: text.index("\n\n") + 2]
@@ -334,7 +383,8 @@ class LocalEngine:
         return Generation(text=text, prompt_tokens=len(tokens), reused_tokens=reused, generated_tokens=generated,
                           prompt_ms=(prompt_done - started) * 1000, generate_ms=(done - prompt_done) * 1000,
                           finished=finished, first_piece=first_piece, first_probability=first_probability,
-                          token_probabilities=tuple(chosen), endings=tuple(endings))
+                          token_probabilities=tuple(chosen), endings=tuple(endings), tokens=tuple(picked),
+                          forks=tuple(forks))
 
     def close(self) -> None:
         close = getattr(self.llm, "close", None)

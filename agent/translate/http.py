@@ -9,7 +9,7 @@ import urllib.request
 from typing import Any
 
 from agent.translate.automaton import RslAutomaton
-from agent.translate.engine import CancelFlag, Generation, GenerationCancelled
+from agent.translate.engine import CancelFlag, Fork, Generation, GenerationCancelled
 
 
 class EndpointError(RuntimeError):
@@ -32,7 +32,10 @@ class HttpEngine:
         self._url = f"{base}/v1/completions"
 
     def generate(self, prompt: str, automaton: RslAutomaton | None, max_tokens: int,
-                 cancel: CancelFlag | None = None) -> Generation:
+                 cancel: CancelFlag | None = None, fork: Fork | None = None) -> Generation:
+        if fork is not None:
+            # A server returns no token choices, so its generations offer no forks to take.
+            raise ValueError("an OpenAI-compatible endpoint cannot continue from a fork")
         if cancel is not None and cancel.is_set():
             # One request cannot be interrupted; a cancel takes effect before the next.
             raise GenerationCancelled("generation cancelled")

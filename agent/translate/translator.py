@@ -24,7 +24,7 @@ from agent.normalize import normalize_task
 from agent.translate.automaton import RslAutomaton
 from agent.translate.clauses import Clause, split_clauses
 from agent.translate.confidence import Assessment, assess, model_signal, result_fields
-from agent.translate.engine import CancelFlag, Generation
+from agent.translate.engine import CancelFlag, Fork, Generation
 from agent.translate.model_path import ModelNotFoundError
 from agent.translate.prompt import (
     Shot,
@@ -63,6 +63,11 @@ _NOT_OBJECTS = frozenset({"left", "right", "start", "origin", "beginning", "way"
 # The least probability the model must have given to ending a program early for that ending to be
 # tried when the whole program fails a meaning check (see Translator._shorter_ending).
 ENDING_FLOOR = 0.05
+# When a program fails a meaning check and no earlier ending passes, the model's runner-up tokens at
+# least this likely are tried, the likeliest first and at most MAX_FORKS of them (a generation each).
+# Set before any measurement, not fitted to a task set.
+FORK_FLOOR = 0.1
+MAX_FORKS = 2
 
 _RANGE_CODES = frozenset({Code.OUT_OF_RANGE, Code.NOT_POSITIVE, Code.OUTSIDE_WORKSPACE})
 
@@ -71,7 +76,7 @@ class Engine(Protocol):
     chat_template: str
 
     def generate(self, prompt: str, automaton: RslAutomaton | None, max_tokens: int,
-                 cancel: CancelFlag | None = None) -> Generation: ...
+                 cancel: CancelFlag | None = None, fork: Fork | None = None) -> Generation: ...
 
     def close(self) -> None: ...
 
@@ -115,6 +120,8 @@ class _ClauseState:
     timings: dict[str, float] = field(default_factory=dict)
     probabilities: tuple[float, ...] = ()  # the model's choices under the grammar, for the confidence
     endings: tuple[tuple[int, int, float], ...] = ()  # see Generation.endings
+    tokens: tuple[int, ...] = ()  # see Generation.tokens and .forks
+    forks: tuple[tuple[int, int, float], ...] = ()
 
 
 class Translator:
@@ -217,6 +224,7 @@ class Translator:
                 state.program = _tidy(generation.text)
                 state.probabilities = generation.token_probabilities
                 state.endings = generation.endings
+                state.tokens, state.forks = generation.tokens, generation.forks
                 state.refused = self.options.refusal and state.program == NO_PROGRAM + "\n"
                 progress.debug("pass %d, clause %r -> %r (prompt %.0f ms, generation %.0f ms)", len(attempts) + 1,
                                state.clause.text, state.program.strip(), generation.prompt_ms,
@@ -249,12 +257,15 @@ class Translator:
             checks_started = time.perf_counter()
             model = model_signal(p for s in states for p in s.probabilities)
             assessment = assess(normalized, plan, self.profile, model=model, known_objects=known)
+            regenerated = 0.0
             if len(states) == 1 and assessment.doubts:
-                shorter = self._shorter_ending(states[0], normalized, known)
-                if shorter is not None:
-                    program, plan, _probabilities, assessment = shorter
+                other = self._shorter_ending(states[0], normalized, known)
+                if other is None:
+                    other, regenerated = self._other_choice(states[0], normalized, known, cancel, timings)
+                if other is not None:
+                    program, plan, _probabilities, assessment = other
             judged = result_fields(plan, self.profile, assessment)
-            timings["checks"] = (time.perf_counter() - checks_started) * 1000
+            timings["checks"] = (time.perf_counter() - checks_started) * 1000 - regenerated
         timings["total"] = (time.perf_counter() - started) * 1000
         progress.debug("%s after %d pass(es) in %.0f ms: prompt %.0f ms, generation %.0f ms, compile %.1f ms",
                        "verified" if verified else "NOT verified", len(attempts), timings["total"],
@@ -296,6 +307,45 @@ class Translator:
                            "after %d statement(s) (p=%.2f), and that passes them", count, probability)
             return program, compiled.plan, probabilities, assessment
         return None
+
+    def _other_choice(self, state: _ClauseState, normalized: str, known: Collection[str] | None,
+                      cancel: CancelFlag | None, timings: dict[str, float]
+                      ) -> tuple[tuple[str, Plan, tuple[float, ...], Assessment] | None, float]:
+        """The program from the model's likeliest other token, where the whole program fails a meaning
+        check and that one passes them; and the milliseconds spent generating.
+
+        A small model that picks "turnleft" where the task said right often weighed "turnright" too.
+        Going back to the places where its runner-up was at least FORK_FLOOR likely, and letting it
+        go on greedily from that token, finds the program it nearly wrote. Only a program with no doubt
+        is taken, and the runner-up's probability is part of the model's signal, so a choice the model
+        was torn over still lowers the confidence and the person is asked.
+        """
+        if not state.tokens:
+            return None, 0.0
+        prompt = self.prompt_for(state.clause.text, state.extra)
+        automaton = self._automaton(state)
+        spent = 0.0
+        for position, token, probability in sorted(state.forks, key=lambda f: -f[2])[:MAX_FORKS]:
+            if probability < FORK_FLOOR:
+                break
+            fork = Fork(state.tokens[:position], state.probabilities[:position], token)
+            generation = self.engine.generate(prompt, automaton, MAX_TOKENS, cancel, fork=fork)
+            timings["prompt"] += generation.prompt_ms
+            timings["generate"] += generation.generate_ms
+            spent += generation.prompt_ms + generation.generate_ms
+            program = _tidy(generation.text)
+            compiled = compile_program(program, self.profile, known)
+            if compiled.plan is None or not compiled.ok or not len(compiled.plan) or not generation.finished:
+                continue
+            assessment = assess(normalized, compiled.plan, self.profile,
+                                model=model_signal(generation.token_probabilities), known_objects=known)
+            if assessment.doubts:
+                continue
+            progress.debug("the checks found fault with the whole program; the model's other choice "
+                           "(p=%.2f) after %d token(s) gives %r, which passes them", probability, position,
+                           program.strip())
+            return (program, compiled.plan, generation.token_probabilities, assessment), spent
+        return None, spent
 
     def prompt_for(self, text: str, extra: str = "") -> str:
         """The prompt for one normalized clause; `extra` is repair feedback."""

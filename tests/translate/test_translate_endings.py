@@ -1,4 +1,5 @@
-"""Where the model could have ended a program, and the earlier ending tried when the whole one fails a check."""
+"""Where the model could have ended a program or chosen another token, and what is tried from there when the
+whole program fails a meaning check."""
 
 from __future__ import annotations
 
@@ -6,7 +7,8 @@ from agent.normalize import normalize_task
 from agent.translate import Translator
 from agent.translate.automaton import RslAutomaton
 from agent.translate.clauses import Clause
-from agent.translate.translator import ENDING_FLOOR, _ClauseState
+from agent.translate.engine import Fork
+from agent.translate.translator import ENDING_FLOOR, FORK_FLOOR, _ClauseState
 
 SQUARE_SIDE = "forward 1;\nturnleft 1.5708;\n"
 
@@ -54,3 +56,57 @@ def test_an_ending_the_model_hardly_weighed_is_not_taken(translator: Translator)
 def test_an_earlier_ending_that_also_fails_the_checks_is_not_taken(translator: Translator) -> None:
     state = _square_state(sides=5, ending_after=4, probability=0.6)  # two sides of a square
     assert translator._shorter_ending(state, state.clause.text, None) is None
+
+
+def _tokens(translator: Translator, text: str) -> tuple[int, ...]:
+    return tuple(translator.engine.llm.tokenize(text.encode(), add_bos=False, special=False))  # type: ignore[attr-defined]
+
+
+def _wrong_turn(translator: Translator, runner_up: float) -> _ClauseState:
+    """"turn right 90 degrees" written as a left turn, where the model's runner-up after "turn" was "right"."""
+    state = _ClauseState(Clause(text=normalize_task("turn right 90 degrees")))
+    state.program = "turnleft 1.5708;\n"
+    state.tokens = _tokens(translator, "turnleft 1.5708;\n\n")
+    state.probabilities = tuple(0.99 for _ in state.tokens)
+    state.forks = ((1, _tokens(translator, "turnright")[1], runner_up),)
+    return state
+
+
+def test_a_fork_on_the_token_the_model_chose_repeats_its_generation(translator: Translator) -> None:
+    automaton = RslAutomaton(translator.profile)
+    prompt = translator.prompt_for(normalize_task("drive forward 2 meters, then turn left 45 degrees"))
+    first = translator.engine.generate(prompt, automaton, 40)
+    assert first.tokens and len(first.tokens) == len(first.token_probabilities)
+    for at in (0, 3, len(first.tokens) - 1):
+        fork = Fork(first.tokens[:at], first.token_probabilities[:at], first.tokens[at])
+        again = translator.engine.generate(prompt, automaton, 40, fork=fork)
+        assert again.text == first.text and again.tokens == first.tokens
+        assert again.token_probabilities[:at] == first.token_probabilities[:at]
+        assert abs(again.token_probabilities[at] - first.token_probabilities[at]) < 1e-3
+    assert all(0 <= at < len(first.tokens) and token != first.tokens[at] and 0.0 < p < 1.0
+               for at, token, p in first.forks)
+
+
+def test_a_failed_check_takes_the_model_s_other_choice_that_passes(translator: Translator) -> None:
+    state = _wrong_turn(translator, runner_up=0.4)
+    timings = {"prompt": 0.0, "generate": 0.0}
+    found, spent = translator._other_choice(state, state.clause.text, None, None, timings)
+    assert found is not None and spent > 0 and timings["generate"] > 0
+    program, plan, probabilities, assessment = found
+    assert program == "turnright 1.5708;\n" and not assessment.doubts and len(plan) == 1
+    # The tokens before the fork keep the probabilities the model gave them.
+    assert probabilities[0] == 0.99
+
+
+def test_a_runner_up_the_model_hardly_weighed_is_not_tried(translator: Translator) -> None:
+    state = _wrong_turn(translator, runner_up=FORK_FLOOR / 2)
+    found, spent = translator._other_choice(state, state.clause.text, None, None, {"prompt": 0.0, "generate": 0.0})
+    assert found is None and spent == 0.0
+
+
+def test_another_choice_that_also_fails_the_checks_is_not_taken(translator: Translator) -> None:
+    state = _wrong_turn(translator, runner_up=0.4)
+    # A head move in place of the turn: the task asked about the base.
+    state.forks = ((0, _tokens(translator, "lookright")[0], 0.4),)
+    found, spent = translator._other_choice(state, state.clause.text, None, None, {"prompt": 0.0, "generate": 0.0})
+    assert found is None and spent > 0
