@@ -225,6 +225,8 @@ class Translator:
                 state.probabilities = generation.token_probabilities
                 state.endings = generation.endings
                 state.tokens, state.forks = generation.tokens, generation.forks
+                if not generation.finished and generation.endings:
+                    _end_where_weighed(state, generation.text)
                 state.refused = self.options.refusal and state.program == NO_PROGRAM + "\n"
                 progress.debug("pass %d, clause %r -> %r (prompt %.0f ms, generation %.0f ms)", len(attempts) + 1,
                                state.clause.text, state.program.strip(), generation.prompt_ms,
@@ -544,6 +546,27 @@ class Translator:
 # Below this first-token probability the adapter is guessing. On the evaluation suite and the new
 # phrasings (207 clauses) the lowest was 0.78, on 18 chit-chat lines the median 0.6 (bench_eval's sets).
 UNSURE_BELOW = 0.5
+
+
+def _end_where_weighed(state: _ClauseState, text: str) -> None:
+    """End a program the token cap cut off where the model most weighed ending it.
+
+    A small model can repeat steps until the cap ("turn right, then left, then right again" as a
+    dozen turns): the cut-off program never compiles, and a repair pass loops the same way, seconds
+    each. Its likeliest ending is a program that may be right; the ending's probability joins the
+    model's signal, so a doubtful one is asked about, not run.
+    """
+    count, chosen, probability = max(state.endings, key=lambda e: e[2])
+    cut = 0
+    for _ in range(count):
+        cut = text.index(";", cut) + 1
+    state.program = _tidy(text[:cut] + "\n")
+    state.probabilities = (*state.probabilities[:chosen], probability)
+    state.tokens = state.tokens[:chosen]
+    state.forks = tuple(f for f in state.forks if f[0] < chosen)
+    state.endings = tuple(e for e in state.endings if e[1] < chosen)
+    progress.debug("the token cap cut the program off; ended after %d statement(s), where the model "
+                   "weighed ending at p=%.2f", count, probability)
 
 
 def _reads_as_task(generation: Generation, profile: Profile) -> bool:

@@ -3,12 +3,18 @@ whole program fails a meaning check."""
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
+import pytest
+
 from agent.normalize import normalize_task
 from agent.translate import Translator
 from agent.translate.automaton import RslAutomaton
 from agent.translate.clauses import Clause
+from agent.translate.confidence import UNSURE_BELOW
 from agent.translate.engine import Fork
-from agent.translate.translator import ENDING_FLOOR, FORK_FLOOR, _ClauseState
+from agent.translate.translator import ENDING_FLOOR, FORK_FLOOR, _ClauseState, _end_where_weighed
+from rsl.profile import Profile
 
 SQUARE_SIDE = "forward 1;\nturnleft 1.5708;\n"
 
@@ -110,3 +116,34 @@ def test_another_choice_that_also_fails_the_checks_is_not_taken(translator: Tran
     state.forks = ((0, _tokens(translator, "lookright")[0], 0.4),)
     found, spent = translator._other_choice(state, state.clause.text, None, None, {"prompt": 0.0, "generate": 0.0})
     assert found is None and spent > 0
+
+
+@pytest.fixture(scope="module")
+def adapted(profile: Profile) -> Iterator[Translator]:
+    loaded = Translator.load(profile)
+    yield loaded
+    loaded.close()
+
+
+def test_a_program_the_token_cap_cut_off_ends_where_the_model_weighed_ending(adapted: Translator) -> None:
+    # The shipped adapter repeats these turns until the token cap; before, each of three passes did,
+    # and nothing was verified after seven seconds.
+    result = adapted.translate("turn right, then turn left, then turn right again")
+    assert result.verified and result.passes == 1 and result.plan is not None
+    assert 2 <= len(result.plan) <= 4
+    assert result.confidence is not None and result.confidence < UNSURE_BELOW
+
+
+def test_the_cut_keeps_the_statements_before_the_likeliest_ending() -> None:
+    state = _ClauseState(Clause(text="turn right then left then right again"))
+    text = "turnright 1.5708;\nturnleft 1.5708;\nturnright 1.5708;\nturnleft 1.5708;\nturnri"
+    state.program = text
+    state.tokens = tuple(range(50))
+    state.probabilities = tuple(0.9 for _ in range(50))
+    state.endings = ((1, 11, 0.1), (2, 22, 0.2), (3, 33, 0.35), (4, 44, 0.05))
+    state.forks = ((5, 7, 0.2), (40, 7, 0.3))
+    _end_where_weighed(state, text)
+    assert state.program == "turnright 1.5708;\nturnleft 1.5708;\nturnright 1.5708;\n"
+    assert state.probabilities == (*(0.9 for _ in range(33)), 0.35)
+    assert state.tokens == tuple(range(33)) and state.forks == ((5, 7, 0.2),)
+    assert [e[0] for e in state.endings] == [1, 2]
