@@ -8,7 +8,7 @@ import pytest
 
 from agent.translate import Translator
 from agent.translate.automaton import END, START, RslAutomaton
-from agent.translate.engine import CancelFlag, Generation, TokenMasks
+from agent.translate.engine import CancelFlag, Fork, Generation, TokenMasks
 from rsl.diagnostics import Code
 from rsl.grammar import to_gbnf
 from rsl.profile import Profile
@@ -61,10 +61,11 @@ class _PrimedEngine:
         self.prompts: list[str] = []
 
     def generate(self, prompt: str, automaton: RslAutomaton | None, max_tokens: int,
-                 cancel: CancelFlag | None = None) -> Generation:
+                 cancel: CancelFlag | None = None, fork: Fork | None = None) -> Generation:
         self.prompts.append(prompt)
         shots = "".join(f"Task: {t}\nRSL:\n{REFUSAL}" for t in ("tell me a joke", "hello there", "how are you"))
-        return self.engine.generate(shots + "Task: what time is it\nRSL:\n", automaton, max_tokens)  # type: ignore[attr-defined]
+        return self.engine.generate(shots + "Task: what time is it\nRSL:\n", automaton, max_tokens,  # type: ignore[attr-defined]
+                                    fork=fork)
 
     def close(self) -> None:
         """The wrapped engine belongs to the session fixture."""
