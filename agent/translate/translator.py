@@ -69,6 +69,9 @@ ENDING_FLOOR = 0.05
 FORK_FLOOR = 0.1
 MAX_FORKS = 2
 
+# Another program for a whole task: its text, plan, the model's probabilities and the assessment.
+_Candidate = tuple[str, Plan, tuple[float, ...], Assessment]
+
 _RANGE_CODES = frozenset({Code.OUT_OF_RANGE, Code.NOT_POSITIVE, Code.OUTSIDE_WORKSPACE})
 
 
@@ -259,14 +262,15 @@ class Translator:
             checks_started = time.perf_counter()
             model = model_signal(p for s in states for p in s.probabilities)
             assessment = assess(normalized, plan, self.profile, model=model, known_objects=known)
-            regenerated = 0.0
+            generating = timings["prompt"] + timings["generate"]
             if len(states) == 1 and assessment.doubts:
-                other = self._shorter_ending(states[0], normalized, known)
-                if other is None:
-                    other, regenerated = self._other_choice(states[0], normalized, known, cancel, timings)
+                other = (self._shorter_ending(states[0], normalized, known)
+                         or self._other_choice(states[0], normalized, known, cancel, timings))
                 if other is not None:
                     program, plan, _probabilities, assessment = other
             judged = result_fields(plan, self.profile, assessment)
+            # A fork's generation is counted as generation, not as checking.
+            regenerated = timings["prompt"] + timings["generate"] - generating
             timings["checks"] = (time.perf_counter() - checks_started) * 1000 - regenerated
         timings["total"] = (time.perf_counter() - started) * 1000
         progress.debug("%s after %d pass(es) in %.0f ms: prompt %.0f ms, generation %.0f ms, compile %.1f ms",
@@ -277,7 +281,7 @@ class Translator:
                                  plan=plan, model=self.model_name, timings_ms=timings, **judged)
 
     def _shorter_ending(self, state: _ClauseState, normalized: str, known: Collection[str] | None
-                        ) -> tuple[str, Plan, tuple[float, ...], Assessment] | None:
+                        ) -> _Candidate | None:
         """The program without its last repetition, where the model weighed ending there and the checks pass.
 
         A small model that repeats a step N times often writes it N + 1 times ("a square" with five
@@ -297,24 +301,18 @@ class Translator:
             if lines[count:] != lines[count - dropped:count]:
                 continue
             program = "".join(line + "\n" for line in lines[:count])
-            compiled = compile_program(program, self.profile, known)
-            if compiled.plan is None or not compiled.ok:
-                continue
-            probabilities = (*state.probabilities[:chosen], probability)
-            assessment = assess(normalized, compiled.plan, self.profile, model=model_signal(probabilities),
-                                known_objects=known)
-            if assessment.doubts:
+            passing = self._passing(program, (*state.probabilities[:chosen], probability), normalized, known)
+            if passing is None:
                 continue
             progress.debug("the checks found fault with the whole program; the model could also have ended "
                            "after %d statement(s) (p=%.2f), and that passes them", count, probability)
-            return program, compiled.plan, probabilities, assessment
+            return passing
         return None
 
     def _other_choice(self, state: _ClauseState, normalized: str, known: Collection[str] | None,
-                      cancel: CancelFlag | None, timings: dict[str, float]
-                      ) -> tuple[tuple[str, Plan, tuple[float, ...], Assessment] | None, float]:
+                      cancel: CancelFlag | None, timings: dict[str, float]) -> _Candidate | None:
         """The program from the model's likeliest other token, where the whole program fails a meaning
-        check and that one passes them; and the milliseconds spent generating.
+        check and that one passes them; the generations' time is added to `timings`.
 
         A small model that picks "turnleft" where the task said right often weighed "turnright" too.
         Going back to the places where its runner-up was at least FORK_FLOOR likely, and letting it
@@ -323,10 +321,9 @@ class Translator:
         was torn over still lowers the confidence and the person is asked.
         """
         if not state.tokens:
-            return None, 0.0
+            return None
         prompt = self.prompt_for(state.clause.text, state.extra)
         automaton = self._automaton(state)
-        spent = 0.0
         for position, token, probability in sorted(state.forks, key=lambda f: -f[2])[:MAX_FORKS]:
             if probability < FORK_FLOOR:
                 break
@@ -334,20 +331,29 @@ class Translator:
             generation = self.engine.generate(prompt, automaton, MAX_TOKENS, cancel, fork=fork)
             timings["prompt"] += generation.prompt_ms
             timings["generate"] += generation.generate_ms
-            spent += generation.prompt_ms + generation.generate_ms
-            program = _tidy(generation.text)
-            compiled = compile_program(program, self.profile, known)
-            if compiled.plan is None or not compiled.ok or not len(compiled.plan) or not generation.finished:
+            if not generation.finished:
                 continue
-            assessment = assess(normalized, compiled.plan, self.profile,
-                                model=model_signal(generation.token_probabilities), known_objects=known)
-            if assessment.doubts:
+            passing = self._passing(_tidy(generation.text), generation.token_probabilities, normalized, known)
+            if passing is None:
                 continue
             progress.debug("the checks found fault with the whole program; the model's other choice "
                            "(p=%.2f) after %d token(s) gives %r, which passes them", probability, position,
-                           program.strip())
-            return (program, compiled.plan, generation.token_probabilities, assessment), spent
-        return None, spent
+                           passing[0].strip())
+            return passing
+        return None
+
+    def _passing(self, program: str, probabilities: tuple[float, ...], normalized: str,
+                 known: Collection[str] | None) -> _Candidate | None:
+        """`program` with its plan and assessment, when it compiles to at least one step and no meaning
+        check doubts it; the model's signal comes from `probabilities`."""
+        compiled = compile_program(program, self.profile, known)
+        if compiled.plan is None or not compiled.ok or not len(compiled.plan):
+            return None
+        assessment = assess(normalized, compiled.plan, self.profile, model=model_signal(probabilities),
+                            known_objects=known)
+        if assessment.doubts:
+            return None
+        return program, compiled.plan, probabilities, assessment
 
     def prompt_for(self, text: str, extra: str = "") -> str:
         """The prompt for one normalized clause; `extra` is repair feedback."""
