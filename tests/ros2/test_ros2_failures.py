@@ -12,6 +12,8 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+import pytest
+
 from agent.robot import CancelToken, Outcome, Status
 from agent.ros2.backend import Ros2Robot
 from agent.ros2.config import RosConfig
@@ -159,29 +161,21 @@ def test_malformed_object_reports_fail_with_a_clear_reason(bridge: Bridge, probe
     assert "malformed" in outcome.reason and "not the documented JSON" in outcome.reason
 
 
-def test_a_missing_service_fails_the_step_instead_of_hanging(bridge: Bridge, probe: Probe,
-                                                              profile: Profile) -> None:
+@pytest.mark.parametrize(("setting", "step", "reasons"), [
+    ("perceive_service", lambda robot: robot.perceive(), ("service /nobody/perceive_service is not available",)),
+    ("cmd_vel", lambda robot: robot.forward(0.5), ("nobody subscribes to /nobody/cmd_vel", "controller running")),
+], ids=["a missing service", "a drive nobody listens to"])
+def test_a_missing_peer_fails_the_step_says_which_and_does_not_hang(
+        bridge: Bridge, probe: Probe, profile: Profile, setting: str, step: Callable[[Ros2Robot], Outcome],
+        reasons: tuple[str, ...]) -> None:
     probe.reset_world()
-    config = dataclasses.replace(RosConfig.from_profile(profile), perceive_service="/nobody/perceive")
+    config = dataclasses.replace(RosConfig.from_profile(profile), **{setting: f"/nobody/{setting}"})
     with Ros2Robot(profile, config=config, connect_timeout=30.0) as robot:
         started = time.monotonic()
-        outcome = robot.perceive()
+        outcome = step(robot)
     assert outcome.status is Status.FAILED
-    assert "service /nobody/perceive is not available" in outcome.reason
-    # Bounded by discovery's allowance after start-up, not by the service's answer time.
-    assert time.monotonic() - started < config.discovery_timeout + 1.0
-
-
-def test_a_drive_nobody_listens_to_fails_the_step_and_says_which_topic(bridge: Bridge, probe: Probe,
-                                                                       profile: Profile) -> None:
-    probe.reset_world()
-    config = dataclasses.replace(RosConfig.from_profile(profile), cmd_vel="/nobody/cmd_vel")
-    with Ros2Robot(profile, config=config, connect_timeout=30.0) as robot:
-        started = time.monotonic()
-        outcome = robot.forward(0.5)
-    assert outcome.status is Status.FAILED
-    assert "nobody subscribes to /nobody/cmd_vel" in outcome.reason
-    assert "controller running" in outcome.reason
+    assert all(reason in outcome.reason for reason in reasons), outcome.reason
+    # Bounded by discovery's allowance after start-up, not by the peer's answer time.
     assert time.monotonic() - started < config.discovery_timeout + 1.0
     assert all(t.linear == 0.0 and t.angular == 0.0 for t in probe.twists), "the real base was commanded"
 
