@@ -141,24 +141,14 @@ def train(pairs: Sequence[Pair], base_gguf: Path, out: Path, recipe: Recipe, *,
     trainable = [p for p in model.parameters() if p.requires_grad]
     optimizer = torch.optim.AdamW(trainable, lr=recipe.learning_rate, weight_decay=0.0)
 
-    def rate(step: int) -> float:
-        if step < recipe.warmup:
-            return (step + 1) / recipe.warmup
-        progress_ = (step - recipe.warmup) / max(1, recipe.steps - recipe.warmup)
-        return 0.1 + 0.9 * 0.5 * (1 + math.cos(math.pi * progress_))
-
-    scheduler = torch.optim.lr_scheduler.LambdaLR(optimizer, rate)
+    scheduler = torch.optim.lr_scheduler.LambdaLR(optimizer, schedule(recipe))
     pad = tokenizer.pad_token_id if tokenizer.pad_token_id is not None else 0
     losses: list[float] = []
     started = time.monotonic()
     progress(f"training {sum(p.numel() for p in trainable):,} LoRA weights on {len(examples)} pairs, "
              f"{recipe.steps} steps of {recipe.batch}, on {device}")
     for step, group in enumerate(plan):
-        width = max(len(ids) for ids, _ in group)
-        input_ids = torch.tensor([ids + [pad] * (width - len(ids)) for ids, _ in group], device=device)
-        labels = torch.tensor([lab + [-100] * (width - len(lab)) for _, lab in group], device=device)
-        mask = torch.tensor([[1] * len(ids) + [0] * (width - len(ids)) for ids, _ in group], device=device)
-        loss = answer_loss(model, input_ids, mask, labels)
+        loss = answer_loss(model, *collate(group, pad, device))
         loss.backward()
         torch.nn.utils.clip_grad_norm_(trainable, 1.0)
         optimizer.step()
@@ -186,10 +176,31 @@ def train(pairs: Sequence[Pair], base_gguf: Path, out: Path, recipe: Recipe, *,
                        losses=tuple(losses))
 
 
+def schedule(recipe: Recipe) -> Callable[[int], float]:
+    """The learning-rate factor per step: linear warm-up, then cosine decay to 10%."""
+    def rate(step: int) -> float:
+        if step < recipe.warmup:
+            return (step + 1) / recipe.warmup
+        done = (step - recipe.warmup) / max(1, recipe.steps - recipe.warmup)
+        return 0.1 + 0.9 * 0.5 * (1 + math.cos(math.pi * done))
+    return rate
+
+
+def collate(group: list[tuple[list[int], list[int]]], pad: int, device: str) -> tuple[Any, Any, Any]:
+    """(input ids, attention mask, labels) of a batch, right-padded to its longest example."""
+    import torch
+
+    width = max(len(ids) for ids, _ in group)
+    input_ids = torch.tensor([ids + [pad] * (width - len(ids)) for ids, _ in group], device=device)
+    mask = torch.tensor([[1] * len(ids) + [0] * (width - len(ids)) for ids, _ in group], device=device)
+    labels = torch.tensor([lab + [-100] * (width - len(lab)) for _, lab in group], device=device)
+    return input_ids, mask, labels
+
+
 def _write(model: Any, out: Path, recipe: Recipe, base_gguf: Path, metadata: dict[str, str] | None) -> None:
     tensors = {gguf_tensor_name(name): param.detach().float().cpu().numpy()
                for name, param in model.named_parameters() if "lora_" in name}
-    write_lora_gguf(out, tensors, alpha=recipe.alpha, architecture=_architecture(base_gguf),
+    write_lora_gguf(out, tensors, alpha=recipe.alpha, architecture=model_architecture(base_gguf),
                     name=out.stem, metadata=metadata)
 
 
@@ -201,7 +212,8 @@ def answer_loss(model: Any, input_ids: Any, mask: Any, labels: Any) -> Any:
     """
     import torch
 
-    causal_lm = model.get_base_model()
+    # A LoRA model wraps the causal LM; a fully fine-tuned one is the causal LM.
+    causal_lm = model.get_base_model() if hasattr(model, "get_base_model") else model
     hidden = causal_lm.model(input_ids=input_ids, attention_mask=mask).last_hidden_state
     targets = labels[:, 1:]
     where = targets != -100
@@ -212,7 +224,7 @@ def answer_loss(model: Any, input_ids: Any, mask: Any, labels: Any) -> Any:
     return torch.nn.functional.cross_entropy(logits.float(), targets[where])
 
 
-def _architecture(gguf_path: Path) -> str:
+def model_architecture(gguf_path: Path) -> str:
     import gguf
 
     reader = gguf.GGUFReader(str(gguf_path))
