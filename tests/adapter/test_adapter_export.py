@@ -64,3 +64,18 @@ def test_the_writer_refuses_unpaired_or_misnamed_tensors(tmp_path: Path) -> None
         write_lora_gguf(tmp_path / "x.gguf", {"blk.0.attn_q.weight": a}, alpha=2, architecture="gemma3",
                         name="x")
     assert not (tmp_path / "x.gguf").exists()
+
+
+@pytest.mark.parametrize("shape", [(256, 640), (2048, 640), (640, 2048)])
+def test_a_full_fine_tune_delta_is_exported_exactly_as_full_rank_factors(shape: tuple[int, int]) -> None:
+    requires("torch")
+    import torch
+
+    from bench.bench_full_finetune import full_rank_factors
+
+    delta = torch.randn(shape, generator=torch.Generator().manual_seed(0)) * 1e-3
+    a, b = full_rank_factors(delta)
+    rank = min(shape)
+    assert a.shape == (rank, shape[1]) and b.shape == (shape[0], rank)
+    # llama.cpp adds B @ A scaled by alpha / rank, and the export writes alpha 1.
+    torch.testing.assert_close(b @ a / rank, delta)
