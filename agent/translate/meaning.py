@@ -180,13 +180,16 @@ def _build_vocabulary(profile: Profile) -> _Vocabulary:
                                              | direction_words))
 
 
-_VOCABULARIES: dict[str, _Vocabulary] = {}
+_VOCABULARIES: dict[tuple[str, str], _Vocabulary] = {}
 
 
 def _vocabulary(profile: Profile) -> _Vocabulary:
-    found = _VOCABULARIES.get(profile.digest)
+    # The language digest leaves out the robot's description, which an adapter never learned but the
+    # parts are read from.
+    key = (profile.digest, profile.description)
+    found = _VOCABULARIES.get(key)
     if found is None:
-        found = _VOCABULARIES[profile.digest] = _build_vocabulary(profile)
+        found = _VOCABULARIES[key] = _build_vocabulary(profile)
     return found
 
 

@@ -109,3 +109,14 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
 def test_a_plan_that_does_what_was_said_has_no_doubt(task: str, program: str, profile: Profile) -> None:
     assert reasons(task, program, profile, ["cup", "table", "keys"]) == []
     assert assess(normalize_task(task), plan(program, profile), profile, model=0.9).confidence == 0.9
+
+
+def test_a_robot_described_otherwise_gets_its_own_parts(profile: Profile) -> None:
+    # Same skills, so the same language digest, but this robot's camera is on no head.
+    text = Path(profile.source).read_text(encoding="utf-8")
+    described = text.replace("a pan-tilt head with a camera", "a pan-tilt turret with a camera")
+    assert described != text
+    other = parse_profile(described)
+    assert other.digest == profile.digest
+    assert skill_parts(profile)["lookup"] == "head"
+    assert skill_parts(other)["lookup"] == "base"
