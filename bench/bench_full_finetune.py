@@ -47,6 +47,7 @@ from agent.adapter.train import (
     load_base,
     model_architecture,
     schedule,
+    step_line,
 )
 from agent.translate.model_path import resolve_model
 from rsl.profile import load_profile
@@ -113,11 +114,7 @@ def main() -> int:
         optimizer.zero_grad(set_to_none=True)
         losses.append(float(loss.detach()))
         if step % 10 == 0 or step + 1 == recipe.steps:
-            elapsed = time.monotonic() - training_started
-            recent = losses[-10:]
-            print(f"step {step + 1}/{recipe.steps}  loss {sum(recent) / len(recent):.4f}  "
-                  f"{elapsed / (step + 1):.2f} s/step  eta {elapsed / (step + 1) * (recipe.steps - step - 1) / 60:.1f}"
-                  " min", file=sys.stderr, flush=True)
+            print(step_line(losses, recipe.steps, time.monotonic() - training_started), file=sys.stderr, flush=True)
     train_seconds = time.monotonic() - training_started
     report: dict[str, Any] = {
         "note": "issue 10 capacity: every projection weight fine-tuned (embeddings and norms frozen), same data, "

@@ -25,6 +25,7 @@ import json
 import os
 import sys
 import tomllib
+from collections.abc import Callable
 from pathlib import Path
 
 from agent.adapter.data import Pair, generate
@@ -45,9 +46,9 @@ WRITTEN = Path("bench/written")
 GUARDED = ("bench/fresh", "bench/novel_tasks.toml")
 
 
-def written_pairs(profile: Profile) -> tuple[list[Pair], dict[str, int]]:
-    """The helpers' pairs that may be trained on, and how many were dropped for what."""
-    in_suite = held_out_filter(eval_tasks())
+def written_pairs(profile: Profile, in_suite: Callable[[str], bool]) -> tuple[list[Pair], dict[str, int]]:
+    """The helpers' pairs that may be trained on, and how many were dropped for what; `in_suite` tells
+    a normalized task the evaluation suite holds out."""
     guarded = [normalize_task(item["task"]) for path in _guarded_files()
                for item in tomllib.loads(path.read_text(encoding="utf-8"))["task"]]
     kept: list[Pair] = []
@@ -95,12 +96,12 @@ def main() -> int:
 
     profile = load_profile()
     recipe = dataclasses.replace(Recipe(), threads=os.cpu_count() or 1)
-    written, dropped = written_pairs(profile)
-    generated = generate(profile, recipe.pairs, seed=recipe.seed, exclude=held_out_filter(eval_tasks()))
+    in_suite = held_out_filter(eval_tasks())
+    written, dropped = written_pairs(profile, in_suite)
+    generated = generate(profile, recipe.pairs, seed=recipe.seed, exclude=in_suite)
     pairs = generated[:recipe.pairs - REPEAT * len(written)] + written * REPEAT
     report: dict[str, object] = {
-        "written": sum(1 for path in WRITTEN.glob("w*.toml")
-                       for _ in tomllib.loads(path.read_text(encoding="utf-8"))["task"]),
+        "written": len(written) + sum(dropped.values()),
         "written_kept": len(written), "dropped": dropped,
         "non_tasks_kept": sum(1 for p in written if p.program.startswith(NO_PROGRAM)),
         "repeat": REPEAT, "pairs": len(pairs), "steps": recipe.steps, "threads": recipe.threads}

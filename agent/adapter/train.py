@@ -160,11 +160,7 @@ def train(pairs: Sequence[Pair], base_gguf: Path, out: Path, recipe: Recipe, *,
             _write(model, checkpoint, recipe, base_gguf, metadata)
             progress(f"wrote checkpoint {checkpoint}")
         if step % 10 == 0 or step + 1 == recipe.steps:
-            elapsed = time.monotonic() - started
-            eta = elapsed / (step + 1) * (recipe.steps - step - 1)
-            recent = losses[-10:]
-            progress(f"step {step + 1}/{recipe.steps}  loss {sum(recent) / len(recent):.4f}  "
-                     f"{elapsed / (step + 1):.2f} s/step  eta {eta / 60:.1f} min")
+            progress(step_line(losses, recipe.steps, time.monotonic() - started))
     seconds = time.monotonic() - started
 
     _write(model, out, recipe, base_gguf, metadata)
@@ -184,6 +180,14 @@ def schedule(recipe: Recipe) -> Callable[[int], float]:
         done = (step - recipe.warmup) / max(1, recipe.steps - recipe.warmup)
         return 0.1 + 0.9 * 0.5 * (1 + math.cos(math.pi * done))
     return rate
+
+
+def step_line(losses: Sequence[float], steps: int, elapsed: float) -> str:
+    """The progress line after `len(losses)` of `steps` steps: the running loss, the pace and the ETA."""
+    done = len(losses)
+    recent = losses[-10:]
+    return (f"step {done}/{steps}  loss {sum(recent) / len(recent):.4f}  {elapsed / done:.2f} s/step  "
+            f"eta {elapsed / done * (steps - done) / 60:.1f} min")
 
 
 def collate(group: list[tuple[list[int], list[int]]], pad: int, device: str) -> tuple[Any, Any, Any]:
