@@ -53,11 +53,24 @@ class _Vocabulary:
     part_words: dict[str, frozenset[str]]  # part -> words that name it or its skills, unshared
     directions: tuple[tuple[str, frozenset[str], str, frozenset[str]], ...]  # (skill, words, opposite, words)
     convention_numbers: dict[str, frozenset[float]]  # unit -> values the conventions use
-    convention_programs: tuple[tuple[str, frozenset[str]], ...]  # (phrase, skills of its program)
-    # (phrase, unit -> its values, whether it is a default: its phrase is not in its own example task)
-    amounts: tuple[tuple[str, dict[str, frozenset[float]], bool], ...]
+    conventions: tuple[_Convention, ...]
     coordinates: frozenset[str]  # skills whose numbers are positions, not amounts
     skill_words: frozenset[str]  # keywords, aliases and direction words: never an object's name
+    opposites: dict[str, str]  # skill keyword -> its opposite, both ways
+
+
+@dataclass(frozen=True)
+class _Convention:
+    """A profile convention as the checks read it."""
+
+    phrase: str
+    words: tuple[str, ...]
+    meaning: str
+    amounts: dict[str, frozenset[float]]  # unit -> the values it stands for
+    # An amount that stands in when nothing is said ("no amount given"): its phrase is not in its own task.
+    default: bool
+    skills: frozenset[str]  # the skills of its example program
+    whole: bool  # a whole command ("look around"), run as its program, not an amount of another step
 
 
 def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collection[str] | None = None
@@ -73,6 +86,7 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     doubts += _directions(plan, vocab, words, profile)
     doubts += _numbers(text, plan, vocab, profile)
     doubts += _totals(text, plan, vocab)
+    doubts += _carried_out(_WORD.findall(affirmed), text, plan, vocab)
     doubts += _objects(text, plan, known_objects, vocab)
     return tuple({d.reason: d for d in doubts}.values())
 
@@ -153,8 +167,7 @@ def _build_vocabulary(profile: Profile) -> _Vocabulary:
 
     coordinates = frozenset(s.keyword for s in profile.skills if any(p.is_coordinate for p in s.params))
     numbers: dict[str, set[float]] = {}
-    programs = []
-    amounts = []
+    conventions = []
     for convention in profile.conventions:
         plan = compile_program(convention.program, profile).plan if convention.program else None
         values: dict[str, set[float]] = {}
@@ -169,15 +182,19 @@ def _build_vocabulary(profile: Profile) -> _Vocabulary:
                 values.setdefault(unit, set()).add(abs(float(value)))
         for unit, unit_values in values.items():
             numbers.setdefault(unit, set()).update(unit_values)
-        amounts.append((convention.phrase, {u: frozenset(v) for u, v in values.items()},
-                        convention.phrase not in convention.task))
-        if plan is not None:
-            programs.append((convention.phrase, frozenset(c.skill for c in plan)))
+        whole = convention.whole_command
+        conventions.append(_Convention(
+            phrase=convention.phrase, words=tuple(_WORD.findall(convention.phrase.lower())),
+            meaning=convention.meaning, amounts={u: frozenset(v) for u, v in values.items()},
+            default=not whole and convention.phrase not in convention.task,
+            skills=frozenset(c.skill for c in plan or ()), whole=whole))
+    opposites = {s.keyword: s.opposite for s in profile.skills if s.opposite}
+    opposites.update({o: k for k, o in list(opposites.items())})
     return _Vocabulary(parts=parts, part_words=part_words, directions=tuple(directions),
                        convention_numbers={u: frozenset(v) for u, v in numbers.items()},
-                       convention_programs=tuple(programs), amounts=tuple(amounts), coordinates=coordinates,
+                       conventions=tuple(conventions), coordinates=coordinates,
                        skill_words=frozenset({w for ws in words.values() for w in ws} - set(nouns)
-                                             | direction_words))
+                                             | direction_words), opposites=opposites)
 
 
 _VOCABULARIES: dict[tuple[str, str], _Vocabulary] = {}
@@ -215,7 +232,8 @@ def _parts(plan: Plan, vocab: _Vocabulary, words: set[str], negated: set[str], t
            profile: Profile) -> list[Doubt]:
     """The base moves only when asked for motion; a request about the head moves only the head."""
     used = {vocab.parts.get(c.skill, WHOLE) for c in plan}
-    allowed = {skill for phrase, skills in vocab.convention_programs if phrase in text for skill in skills}
+    tokens = _WORD.findall(text)
+    allowed = {skill for c in vocab.conventions if _names(tokens, c, vocab) for skill in c.skills}
     asked = {part for part, ws in vocab.part_words.items() if words & ws}
     doubts = []
     for part in sorted(used):
@@ -322,9 +340,69 @@ def _totals(text: str, plan: Plan, vocab: _Vocabulary) -> list[Doubt]:
     return doubts
 
 
+# How many words may stand between a phrase's own ("turn all the way around" names "turn around").
+_PHRASE_GAP = 3
+
+
+def _names(tokens: list[str], convention: _Convention, vocab: _Vocabulary) -> bool:
+    """Whether the task's words name `convention`: its words in order, a few others between.
+
+    A word between that asks for a step of its own breaks the phrase: "turn
+    left and go around the table" names no turning around. A long word
+    names its inflections ("exploring", "the starting point").
+    """
+    first, *rest = convention.words
+    for start, token in enumerate(tokens):
+        if not _same(token, first):
+            continue
+        at = start
+        for word in rest:
+            found = next((i for i in range(at + 1, min(len(tokens), at + 2 + _PHRASE_GAP))
+                          if _same(tokens[i], word) or tokens[i] in vocab.skill_words), None)
+            if found is None or not _same(tokens[found], word):
+                break
+            at = found
+        else:
+            return True
+    return False
+
+
+def _same(token: str, word: str) -> bool:
+    return token == word or (len(word) >= 5 and token.startswith(word.rstrip("e")))
+
+
 def _named_amounts(text: str, vocab: _Vocabulary) -> list[dict[str, frozenset[float]]]:
     """The amounts of the conventions the task names, one per convention."""
-    return [values for phrase, values, _default in vocab.amounts if phrase in text]
+    tokens = _WORD.findall(text)
+    return [c.amounts for c in vocab.conventions if _names(tokens, c, vocab)]
+
+
+def _carried_out(tokens: list[str], text: str, plan: Plan, vocab: _Vocabulary) -> list[Doubt]:
+    """A convention the task names is done: a whole command's skills (or their opposites), and its amount.
+
+    The amount is looked for only in units the task gives no number in, and
+    any one of the convention's units will do: "a little" is 20 cm of a drive
+    or 15° of a turn, whichever step it was said of.
+    """
+    said_units = {u for _v, u in _said_numbers(text)}
+    count = _counts(text)
+    skills = {c.skill for c in plan}
+    planned = [(abs(a.value), a.unit) for c in plan if c.skill not in vocab.coordinates
+               for a in c.args if isinstance(a, Quantity)]
+    doubts = []
+    for convention in vocab.conventions:
+        if convention.default or not _names(tokens, convention, vocab):
+            continue
+        missing = convention.whole and any(s not in skills and vocab.opposites.get(s) not in skills
+                                           for s in convention.skills)
+        units = [u for u in convention.amounts if u not in said_units and "" not in said_units]
+        done = not units or any(_close(value, amount * k) for unit in units for amount in convention.amounts[unit]
+                                for value, planned_unit in planned if planned_unit == unit
+                                for k in range(1, count + 1))
+        if missing or not done:
+            doubts.append(Doubt("convention", f'you said "{convention.phrase}" ({convention.meaning}), '
+                                              "but the plan does not do that"))
+    return doubts
 
 
 def _conventions_said(text: str, vocab: _Vocabulary, unit: str) -> float:
@@ -336,7 +414,7 @@ def _vague_amount(text: str, vocab: _Vocabulary, unit: str) -> float:
     """The most a task that says no number may mean: its conventions' amounts, else the defaults'."""
     used = _named_amounts(text, vocab)
     if not used:
-        used = [values for _phrase, values, default in vocab.amounts if default]
+        used = [c.amounts for c in vocab.conventions if c.default]
     return max((v for values in used for v in values.get(unit, ())), default=0.0)
 
 

@@ -77,6 +77,14 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
     ("turn left 45 degrees 4 times", "turnleft 1.5708; " * 4, "you said 180° of turn in all, but the plan turns 360°"),
     ("look up 20 degrees and turn left 45 degrees", "lookup 0.5236; turnleft 0.7854;",
      "the plan uses 30° (look up 30°), which you did not say"),
+    # A convention named is carried out: its amount, or the whole command's skills.
+    ("turn all the way around", "turnright 1.5708;",
+     'you said "turn around" (3.1416 rad (180 degrees), turning left unless told otherwise), '
+     "but the plan does not do that"),
+    ("could you go and get me the cup", "grasp cup;",
+     'you said "go get" (approach the object, grasp it, then come back to the start (goto 0, 0)), '
+     "but the plan does not do that"),
+    ("go a bit further", "forward 1;", 'you said "a bit further" (0.5 m), but the plan does not do that'),
 ])
 def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str, expected: str,
                                                          profile: Profile) -> None:
@@ -105,6 +113,14 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     # A step said without an amount takes its default even where another step's amount was said.
     ("turn right ninety degrees then look left", "turnright 1.5708; lookleft 0.5236;"),
     ("drive forward 2 meters and turn left", "forward 2; turnleft 1.5708;"),
+    ("turn yourself around to the right", "turnright 3.1416;"),
+    ("move forward a little and then turn left", "forward 0.2; turnleft 1.5708;"),
+    ("turn around 2 times", "turnleft 3.1416; turnleft 3.1416;"),
+    ("please go and get me the cup", "approach cup; grasp cup; goto 0, 0;"),
+    ("go exploring", "lookleft 1.5708; perceive; lookright 3.1416; perceive; lookleft 1.5708;"),
+    # Words that ask for a step of their own break a phrase: this "turn ... around" is no turning around.
+    ("turn left and go around the table", "turnleft 1.5708; approach table;"),
+    ("don't turn around, just look left", "lookleft 0.5236;"),
 ])
 def test_a_plan_that_does_what_was_said_has_no_doubt(task: str, program: str, profile: Profile) -> None:
     assert reasons(task, program, profile, ["cup", "table", "keys"]) == []
