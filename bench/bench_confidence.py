@@ -10,6 +10,7 @@ Writes aggregates only:
 - refusal: share of non-tasks with no program, and of tasks refused as non-tasks;
 - auroc: how well the confidence ranks right plans above wrong ones (verified plans only);
 - coverage_curve: accuracy of the plans kept when only those at or above a confidence are run;
+- questioned_by: for right and wrong plans the policy questions, how many each meaning check doubted;
 - checks_ms p50/p95: the added time of the meaning checks, explanation and confidence per translation.
 
     python bench/bench_confidence.py [--suite FILE] [--out FILE] [--every K]
@@ -26,6 +27,7 @@ import os
 import platform
 import sys
 import time
+from collections import Counter
 from pathlib import Path
 from typing import Any
 
@@ -35,6 +37,7 @@ from agent.evalsuite.suite import accepts, suite_path
 from agent.normalize import normalize_task
 from agent.translate import Translator
 from agent.translate.confidence import UNSURE_BELOW, judge
+from agent.translate.meaning import check_meaning
 from rsl.profile import load_profile
 
 
@@ -44,6 +47,15 @@ def auroc(positives: list[float], negatives: list[float]) -> float | None:
         return None
     wins = sum(1.0 if p > n else 0.5 if p == n else 0.0 for p in positives for n in negatives)
     return wins / (len(positives) * len(negatives))
+
+
+def questioned_by(rows: list[dict[str, Any]]) -> dict[str, int]:
+    """How many of the questioned plans in `rows` each meaning check doubted."""
+    counted: Counter[str] = Counter()
+    for row in rows:
+        if row["confirm"]:
+            counted.update(row["checks"] or ["model"])
+    return dict(sorted(counted.items()))
 
 
 def main() -> int:
@@ -68,15 +80,19 @@ def main() -> int:
     started = time.monotonic()
     for index, task in enumerate(tasks, 1):
         result = translator.translate(task.task, known_objects=task.objects)
+        checks: list[str] = []
         if result.plan is not None:
             # The checks, explanation and confidence again, timed alone and side by side with the translation.
             begin = time.perf_counter()
             judge(normalize_task(task.task), result.plan, profile, (), task.objects)
             checks_ms.append((time.perf_counter() - begin) * 1000)
+            checks = sorted({d.check for d in check_meaning(normalize_task(task.task), result.plan, profile,
+                                                            task.objects)})
         rows.append({"task": task.task, "group": task.group, "refuse": task.refuse, "program": result.program,
                      "verified": result.verified, "right": accepts(task, result.plan, profile),
                      "confidence": result.confidence, "confirm": result.confirm, "refused": result.refused,
-                     "doubts": list(result.doubts), "total_ms": result.timings_ms.get("total", 0.0)})
+                     "doubts": list(result.doubts), "checks": checks,
+                     "total_ms": result.timings_ms.get("total", 0.0)})
         print(f"\r{index}/{len(tasks)} {time.monotonic() - started:.0f} s", end="", file=sys.stderr, flush=True)
     print(file=sys.stderr)
     translator.close()
@@ -103,6 +119,8 @@ def main() -> int:
         "wrong_runs_questioned": sum(1 for r in wrong if r["confirm"]) / len(wrong) if wrong else None,
         "right_questioned": sum(1 for r in right if r["confirm"]) / len(right) if right else None,
         "right_programs": len(right), "wrong_programs": len(wrong),
+        # Which check put each questioned plan in doubt ("model": none did, the model's own signal was low).
+        "questioned_by": {"right": questioned_by(right), "wrong": questioned_by(wrong)},
         "non_tasks_refused": sum(1 for r in chat if not r["verified"]) / len(chat) if chat else None,
         "non_tasks_refused_e201": sum(1 for r in chat if r["refused"]) / len(chat) if chat else None,
         "non_tasks_asked_or_refused": (sum(1 for r in chat if not r["verified"] or r["confirm"]) / len(chat)
