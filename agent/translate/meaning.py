@@ -19,6 +19,7 @@ from __future__ import annotations
 import itertools
 import math
 import re
+from collections import Counter
 from collections.abc import Collection, Iterable
 from dataclasses import dataclass
 
@@ -31,6 +32,7 @@ from rsl.profile import Profile
 _WORD = re.compile(r"[a-z]+")
 _NUMBER_UNIT = re.compile(r"(?<![\w.])(-?\d*\.?\d+)(?: (m|rad)\b)?")
 _COUNT = re.compile(r"\b(\d+) times\b")
+_CLAUSE_START = re.compile(r"(?:^|[,.;]|\band\b|\bthen\b)\s*([a-z]+)")
 _FIRST_CLAUSE = re.compile(r"[.;]")
 # What negates what follows it up to the end of its clause ("don't move, just look left").
 _NEGATION = re.compile(r"\b(?:don'?t|do not|never|without|no|not)\b[^,.;]*")
@@ -56,6 +58,7 @@ class _Vocabulary:
     conventions: tuple[_Convention, ...]
     coordinates: frozenset[str]  # skills whose numbers are positions, not amounts
     skill_words: frozenset[str]  # keywords, aliases and direction words: never an object's name
+    part_nouns: frozenset[str]  # the nouns of the robot's description ("head", "camera")
     opposites: dict[str, str]  # skill keyword -> its opposite, both ways
 
 
@@ -92,9 +95,17 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
 
 
 def _words(text: str, vocab: _Vocabulary) -> set[str]:
-    """The task's words, with a pair that spells a skill word joined: "back up" is `backup`, "pick up" `pickup`."""
+    """The task's words, with a pair that spells a skill word joined: "back up" is `backup`, "pick up" `pickup`.
+
+    A part's noun that starts a clause is a verb there ("head over to the
+    table"), since the noun would need "your" or "the" before it: it asks
+    the robot as a whole to move, not the part.
+    """
     tokens = _WORD.findall(text)
-    return set(tokens) | {a + b for a, b in itertools.pairwise(tokens) if a + b in vocab.skill_words}
+    verbs = Counter(m.group(1) for m in _CLAUSE_START.finditer(text) if m.group(1) in vocab.part_nouns)
+    said = Counter(tokens)
+    return ({t for t in said if verbs[t] < said[t]} | ({WHOLE} if verbs else set())
+            | {a + b for a, b in itertools.pairwise(tokens) if a + b in vocab.skill_words})
 
 
 def skill_parts(profile: Profile) -> dict[str, str]:
@@ -194,7 +205,8 @@ def _build_vocabulary(profile: Profile) -> _Vocabulary:
                        convention_numbers={u: frozenset(v) for u, v in numbers.items()},
                        conventions=tuple(conventions), coordinates=coordinates,
                        skill_words=frozenset({w for ws in words.values() for w in ws} - set(nouns)
-                                             | direction_words), opposites=opposites)
+                                             | direction_words),
+                       part_nouns=frozenset(nouns), opposites=opposites)
 
 
 _VOCABULARIES: dict[tuple[str, str], _Vocabulary] = {}

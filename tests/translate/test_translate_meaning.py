@@ -85,6 +85,8 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
      'you said "go get" (approach the object, grasp it, then come back to the start (goto 0, 0)), '
      "but the plan does not do that"),
     ("go a bit further", "forward 1;", 'you said "a bit further" (0.5 m), but the plan does not do that'),
+    ("turn your head to the left, then head to the table", "turnleft 1.5708; approach table;",
+     "you asked about the head, but the plan never uses it"),
 ])
 def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str, expected: str,
                                                          profile: Profile) -> None:
@@ -121,6 +123,9 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     # Words that ask for a step of their own break a phrase: this "turn ... around" is no turning around.
     ("turn left and go around the table", "turnleft 1.5708; approach table;"),
     ("don't turn around, just look left", "lookleft 0.5236;"),
+    # A part's noun first in its clause is a verb.
+    ("head over to the table", "approach table;"),
+    ("robot, head back to where you started", "goto 0, 0;"),
 ])
 def test_a_plan_that_does_what_was_said_has_no_doubt(task: str, program: str, profile: Profile) -> None:
     assert reasons(task, program, profile, ["cup", "table", "keys"]) == []
