@@ -13,6 +13,8 @@ Safety rules, each enforced in one place:
   emergency stop, error, timeout, stale odometry);
 - odometry older than `odom_timeout` while moving stops the base and fails
   the step;
+- a stop by the robot's bumper during a base motion fails the step at once,
+  naming the obstacle;
 - `stop()` takes the same lock as the control loops' publishing, so no
   motion command can slip out after the emergency stop's zero Twist.
 """
@@ -30,7 +32,7 @@ from agent.ros2.bindings import BindingFailure, BoundSkills
 from agent.ros2.config import RosConfig
 from agent.ros2.geometry import footprint_radius, wrap_angle
 from agent.ros2.link import Odometry, RobotLink, ServiceError, primitives_used
-from agent.ros2.messages import Footprint, FormatError, decode_held, decode_objects
+from agent.ros2.messages import BumperStop, Footprint, FormatError, decode_held, decode_objects
 from agent.ros2.motion import Limits, move_budget, next_speed
 from rsl.profile import Profile, RosBinding, Skill
 
@@ -42,6 +44,11 @@ JOINT_TOLERANCE = 0.01  # rad, or m for the gripper
 STILL_LINEAR = 0.01  # m/s; slower than this counts as standing still
 STILL_ANGULAR = 0.02  # rad/s
 FIRST_MESSAGE_WAIT = 2.0  # s to wait for the first joint states or objects after connecting
+# Reports of a bumper stop can still be in flight when the step it failed has ended, so a step
+# starts once none has arrived for a while. 0.1 s is five ticks of the simulator bridge, and far
+# above DDS latency on a link fit to drive a robot over.
+BUMPER_QUIET = 0.1  # s without a new bumper stop
+BUMPER_QUIET_LIMIT = 1.0  # s at most that a step waits for it
 
 
 class RobotUnavailable(RuntimeError):
@@ -235,6 +242,7 @@ class Ros2Robot(SkillCalls):
         try:
             if token.is_set():
                 return Outcome.cancelled(token.reason)
+            self._link.await_bumper_quiet(BUMPER_QUIET, BUMPER_QUIET_LIMIT)
             return body(token)
         except _Cancelled as exc:
             return Outcome.cancelled(str(exc))
@@ -285,12 +293,14 @@ class Ros2Robot(SkillCalls):
                  command: Callable[[float, Pose], tuple[float, float]], limits: Limits,
                  tolerance: float, budget: float, token: CancelToken, what: str) -> None:
         self._require_listener(lambda: self._link.listeners("cmd_vel"), self.config.cmd_vel)
-        deadline = time.monotonic() + budget
+        started = time.monotonic()
+        deadline = started + budget
         speed = 0.0
         while True:
             odom = self._fresh_odometry()
             remaining = amount - progress(odom.pose)
             self._check_interrupts(token)
+            self._check_bumper(started, what)
             if time.monotonic() > deadline:
                 raise StepFailure(f"{what} timed out after {budget:.1f} s with {abs(remaining):.3f} "
                                   "still to go; the base was stopped. Is something blocking the robot?")
@@ -319,7 +329,8 @@ class Ros2Robot(SkillCalls):
         motion = self.profile.motion
         budget = (move_budget(far, motion.max_linear_speed, motion.max_linear_accel, motion.timeout_margin)
                   + turning / motion.max_angular_speed)
-        deadline = time.monotonic() + budget
+        started = time.monotonic()
+        deadline = started + budget
         with self._publish_lock:
             self._check_interrupts(token)
             self._link.send_goal(x, y, heading)
@@ -329,6 +340,7 @@ class Ros2Robot(SkillCalls):
         try:
             while True:
                 self._check_interrupts(token)
+                self._check_bumper(started, f"the drive to ({x:.2f}, {y:.2f})")
                 odom = self._fresh_odometry()
                 now = time.monotonic()
                 off = math.hypot(x - odom.pose.x, y - odom.pose.y)
@@ -454,6 +466,11 @@ class Ros2Robot(SkillCalls):
         if self._stops != self._generation:
             raise _Cancelled("emergency stop")
 
+    def _check_bumper(self, since: float, what: str) -> None:
+        stop = self._link.bumper_stop(since)
+        if stop is not None:
+            raise StepFailure(_bumped(what, stop))
+
     def _require_listener(self, count: Callable[[], int], topic: str) -> None:
         if not self._link.await_subscriber(count):
             raise StepFailure(f"nobody subscribes to {topic}: the robot would not receive the command. "
@@ -525,6 +542,14 @@ class Ros2Robot(SkillCalls):
         if report is not None and received > self._held_since:
             return report.held
         return self._holding
+
+
+def _bumped(what: str, stop: BumperStop) -> str:
+    it = f"the {stop.obstacle}" if stop.obstacle else "it"
+    obstacle = it if stop.obstacle else "an obstacle"
+    at = f", at ({stop.point[0]:.2f}, {stop.point[1]:.2f}) against the base" if stop.point else ""
+    return (f"{what} stopped: {obstacle} is in the way{at}; the bumper stopped the base before it pushed "
+            f"{it}. Go around {it} or back away from it first.")
 
 
 class _Cancelled(Exception):

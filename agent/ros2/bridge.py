@@ -5,7 +5,8 @@ timeout, as diff-drive controllers have), odometry and joint states at a fixed
 rate, joint trajectory controllers for the head and gripper, a goal-pose
 follower, and the perceive and grasp services and objects topic that
 docs/ros2.md defines, each only when a skill of the profile is bound to the
-primitive that uses it. The backend cannot tell it from a robot.
+primitive that uses it, and the bumper topic, on which the world's bumper
+reports each stop. The backend cannot tell it from a robot.
 
 All callbacks and the physics run on the one executor thread, so the world is
 never touched from two threads at once.
@@ -22,7 +23,7 @@ from agent.ros2.config import RosConfig
 from agent.ros2.geometry import quaternion_from_yaw, wrap_angle, yaw_from_quaternion
 from agent.ros2.goal_follower import Goal, GoalFollower
 from agent.ros2.link import primitives_used
-from agent.ros2.messages import Footprint, encode_held, encode_objects
+from agent.ros2.messages import BumperStop, Footprint, encode_bumper, encode_held, encode_objects
 from agent.ros2.node_thread import NodeThread
 from agent.sim.world import GRASP_BEARING, SimWorld
 from rsl.profile import Profile
@@ -70,8 +71,9 @@ class SimBridge:
         self._odom = node.create_publisher(Odometry, cfg.odom, reliable)
         self._joints = node.create_publisher(JointState, cfg.joint_states, reliable)
         self._objects = node.create_publisher(String, cfg.objects_topic, reliable)
+        self._bumper = node.create_publisher(String, cfg.bumper, reliable)
         node.create_subscription(Twist, cfg.cmd_vel, self._on_cmd_vel, reliable)
-        self.interfaces = [cfg.cmd_vel, cfg.odom, cfg.joint_states, cfg.objects_topic]
+        self.interfaces = [cfg.cmd_vel, cfg.odom, cfg.joint_states, cfg.objects_topic, cfg.bumper]
         if used & {"navigate", "approach_object"}:
             node.create_subscription(PoseStamped, cfg.goal_pose, self._on_goal, reliable)
             self.interfaces.append(cfg.goal_pose)
@@ -96,6 +98,7 @@ class SimBridge:
         self._gripper = self.config.gripper_open_position
         self._gripper_target = self._gripper
         self._ticks = 0
+        self._bumped = False
         self._last_tick = time.monotonic()
         self._owed = 0.0
 
@@ -116,8 +119,17 @@ class SimBridge:
             world.set_base_velocity(0.0, 0.0)
         else:
             world.set_base_velocity(*self._cmd)
+        contact = None
+        for _ in range(steps):
+            world.step()
+            contact = contact or world.blocked_by
         if steps:
-            world.step(steps)
+            # One report per stop, not one per tick: the bumper holds the base while the
+            # command pushes on, and the backend fails the step at the first report.
+            if contact is not None and not self._bumped:
+                stop = BumperStop(contact.name, (contact.x, contact.y), self.config.world_frame)
+                self._bumper.publish(self._string_type(data=encode_bumper(stop)))
+            self._bumped = contact is not None
         self._move_gripper(steps * world.dt)
         self._publish_state()
         self._ticks += 1

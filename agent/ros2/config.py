@@ -31,6 +31,7 @@ class RosConfig:
     head_trajectory: str = _name("/head_controller/joint_trajectory", "head JointTrajectory commands")
     gripper_trajectory: str = _name("/gripper_controller/joint_trajectory", "gripper JointTrajectory commands")
     goal_pose: str = _name("/goal_pose", "Nav2-style navigation goals (geometry_msgs/PoseStamped)")
+    bumper: str = _name("/bumper", "bumper stops of the base (std_msgs/String, JSON); optional")
     # Named after the primitives they serve unless the profile names them.
     perceive_service: str = _name("/perceive_objects", "the perceive_objects primitive's Trigger service")
     objects_topic: str = _name("/objects", "object positions and what is held (std_msgs/String, JSON)")

@@ -1,5 +1,6 @@
 """The backend's ROS 2 plumbing: publishers, subscriptions, service clients, and
-the latest odometry, joint states and object report, each with its arrival time.
+the latest odometry, joint states, object report and bumper stop, each with its
+arrival time.
 
 The skill logic in `backend.py` reads snapshots from here and never sees rclpy
 types, which keeps the control loops short and the safety rules in one place.
@@ -17,7 +18,7 @@ from typing import Any
 from agent.robot import CancelToken, Pose
 from agent.ros2.config import RosConfig
 from agent.ros2.geometry import quaternion_from_yaw, yaw_from_quaternion
-from agent.ros2.messages import FormatError, ObjectReport, decode_objects
+from agent.ros2.messages import BumperStop, FormatError, ObjectReport, decode_bumper, decode_objects
 from agent.ros2.node_thread import NodeThread
 from rsl.profile import PRIMITIVES, Primitive, Profile
 
@@ -64,6 +65,8 @@ class RobotLink:
         self._objects: ObjectReport | None = None
         self._objects_received = 0.0
         self._objects_error = ""
+        self._bumper_stop: BumperStop | None = None
+        self._bumper_received = 0.0
 
         self._ros = NodeThread(node_name)
         node = self._ros.node
@@ -88,6 +91,8 @@ class RobotLink:
         node.create_subscription(JointState, config.joint_states, self._on_joints, qos_profile_sensor_data)
         node.create_subscription(String, config.objects_topic, self._on_objects,
                                  QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT))
+        # Reliable: a bumper stop is an event, not a stream whose next message would make up for a lost one.
+        node.create_subscription(String, config.bumper, self._on_bumper, reliable)
         self._perceive = node.create_client(Trigger, config.perceive_service)
         self._grasp = (node.create_client(Trigger, config.grasp_service) if "grasp_object" in primitives
                        else None)
@@ -127,6 +132,18 @@ class RobotLink:
             self._objects_received = time.monotonic()
             self._objects_error = ""
 
+    def _on_bumper(self, msg: object) -> None:
+        try:
+            stop = decode_bumper(msg.data, f"bumper topic {self.config.bumper}")  # type: ignore[attr-defined]
+        except FormatError as exc:
+            # An unreadable report names no obstacle to fail a step with; a robot whose bumper
+            # cut the drive stands still, and the step's own time budget still ends it.
+            self._ros.node.get_logger().warning(f"ignored a bumper report: {exc}", throttle_duration_sec=1.0)
+            return
+        with self._lock:
+            self._bumper_stop = stop
+            self._bumper_received = time.monotonic()
+
     # -- snapshots -------------------------------------------------------------
 
     def odometry(self) -> Odometry | None:
@@ -156,6 +173,22 @@ class RobotLink:
     def objects_received(self) -> float:
         with self._lock:
             return self._objects_received
+
+    def bumper_stop(self, since: float) -> BumperStop | None:
+        """The latest bumper stop, if one arrived after `since` (a time.monotonic())."""
+        with self._lock:
+            return self._bumper_stop if self._bumper_received > since else None
+
+    def await_bumper_quiet(self, quiet: float, limit: float) -> None:
+        """Wait until no bumper stop has arrived for `quiet` s, at most `limit` s."""
+        deadline = time.monotonic() + limit
+        while True:
+            with self._lock:
+                last = self._bumper_received
+            now = time.monotonic()
+            if now - last >= quiet or now >= deadline:
+                return
+            time.sleep(0.01)
 
     # -- outgoing --------------------------------------------------------------
 

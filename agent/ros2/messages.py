@@ -16,6 +16,10 @@ functions, so the two sides cannot drift apart.
   footprints optional as above); on failure it is a sentence saying why.
 - grasp service (std_srvs/Trigger) picks up the object nearest the gripper;
   on success the message is `{"held": "cup"}`, on failure a sentence saying why.
+- bumper topic (std_msgs/String), one message each time the bumper stops the base:
+  `{"frame": "odom", "obstacle": "table", "x": 2.6, "y": -0.2}`; `obstacle` is null
+  when the robot cannot tell what it is, and the point of the base that was about to
+  touch it (`x`, `y`) may be left out.
 """
 
 from __future__ import annotations
@@ -98,6 +102,39 @@ def _footprint(raw: Any, where: str) -> Footprint:
     if shape not in ("box", "cylinder", "sphere") or sx <= 0 or sy <= 0:
         raise FormatError(f"{where}: footprint shape must be box, cylinder or sphere with a positive size")
     return Footprint(str(shape), (sx, sy), yaw)
+
+
+@dataclass(frozen=True)
+class BumperStop:
+    """The bumper stopped the base short of an obstacle."""
+
+    obstacle: str | None = None  # None: the robot cannot tell what it is
+    point: tuple[float, float] | None = None  # the point of the base about to touch it
+    frame: str = "odom"
+
+
+def encode_bumper(stop: BumperStop) -> str:
+    data: dict[str, object] = {"frame": stop.frame, "obstacle": stop.obstacle}
+    if stop.point is not None:
+        data["x"], data["y"] = round(stop.point[0], 4), round(stop.point[1], 4)
+    return json.dumps(data, separators=(",", ":"))
+
+
+def decode_bumper(text: str, where: str) -> BumperStop:
+    data = _load(text, where)
+    obstacle = data.get("obstacle")
+    if obstacle is not None and not isinstance(obstacle, str):
+        raise FormatError(f"{where}: `obstacle` must be an object name or null, got {obstacle!r}")
+    point = None
+    if "x" in data or "y" in data:
+        try:
+            point = float(data["x"]), float(data["y"])
+        except (TypeError, KeyError, ValueError):
+            raise FormatError(f"{where}: `x` and `y` must both be numbers or both be left out, "
+                              f"got {text[:120]!r}") from None
+        if not all(math.isfinite(v) for v in point):
+            raise FormatError(f"{where}: the point against the base is not finite")
+    return BumperStop(obstacle or None, point, str(data.get("frame", "odom")))
 
 
 def encode_held(held: str) -> str:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
+import re
 import signal
 import threading
 import time
@@ -221,3 +222,60 @@ def test_cancelling_a_head_move_holds_the_head_where_it_is(robot: Ros2Robot) -> 
     time.sleep(1.0)
     assert 0.1 < held < 1.4, held
     assert abs(robot.state().head_pan - held) < 0.02, "the head went on moving after the cancel"
+
+
+@pytest.mark.parametrize(("step", "what"), [
+    (lambda robot: robot.forward(5.0), "`forward 5.0;`"),
+    (lambda robot: robot.goto(4.0, 0.0), "the drive to (4.00, 0.00)"),
+], ids=["a drive", "a goal"])
+def test_a_motion_into_the_table_fails_at_the_bumper_naming_it(
+        robot: Ros2Robot, probe: Probe, step: Callable[[Ros2Robot], Outcome], what: str) -> None:
+    # The table's near edge is at x = 2.6: the base reaches it at full speed about 5 s in,
+    # well inside the step's budget (22.8 s for the drive).
+    outcome = step(robot)
+    failed_at = time.time()
+    assert outcome.status is Status.FAILED
+    assert re.match(rf"{re.escape(what)} stopped: the table is in the way, at \(2\.(59|60), -?0\.\d\d\) against "
+                    "the base; the bumper stopped the base before it pushed the table. Go around the table or "
+                    "back away from it first.$", outcome.reason), outcome.reason
+    # The bumper cuts the drive from full speed at once; the motors' ramp would take five ticks.
+    bumped = [o for o in probe.odoms if o.x > 2.0 and abs(o.linear) < 0.1]
+    assert bumped, "odometry never showed the bumper stopping the base"
+    assert failed_at - bumped[0].at < 0.3, f"failed {failed_at - bumped[0].at:.2f} s after the bumper stop"
+    assert 2.3 < robot.state().pose.x < 2.36
+    # The base may creep on towards the table until the backend's stop reaches it, never after.
+    time.sleep(0.3)
+    zeros = [t for t in probe.twists if t.at >= bumped[0].at and not (t.linear or t.angular)]
+    assert zeros and zeros[0].at - bumped[0].at < 0.2, "no zero Twist followed the bumper stop"
+    assert not [t for t in probe.twists if t.at > zeros[0].at and (t.linear or t.angular)]
+    assert all(abs(o.linear) < STILL for o in probe.odoms if o.at > failed_at), "the base moved after the failure"
+    # Reports of that stop still in flight must not fail the next step, which backs away.
+    assert robot.backward(0.5).ok
+
+
+@pytest.mark.parametrize(("report", "failure"), [
+    ('{"obstacle": 3}', None),
+    ('{"frame": "odom", "obstacle": null}', "`forward 1.0;` stopped: an obstacle is in the way; the bumper stopped "
+                                            "the base before it pushed it. Go around it or back away from it first."),
+], ids=["a garbled one is logged and ignored", "one that cannot name the obstacle"])
+def test_bumper_reports_of_a_real_robot(robot: Ros2Robot, probe: Probe, profile: Profile,
+                                        capfd: pytest.CaptureFixture[str], report: str, failure: str | None) -> None:
+    from std_msgs.msg import String
+
+    bumper = probe.publisher(String, RosConfig.from_profile(profile).bumper)
+    deadline = time.monotonic() + 20.0
+    while bumper.get_subscription_count() == 0:
+        assert time.monotonic() < deadline, "the backend never subscribed to the bumper topic"
+        time.sleep(0.02)
+    thread, result = start_in_background(lambda: robot.forward(1.0))
+    wait_until_moving(probe, speed=0.1)
+    bumper.publish(String(data=report))
+    thread.join(10.0)
+    assert result, "the step never ended"
+    if failure is None:
+        assert result[0].ok, result
+        assert ("ignored a bumper report: bumper topic /bumper: `obstacle` must be an object name or null, got 3"
+                in capfd.readouterr().err)
+    else:
+        assert result[0] == Outcome.failed(failure)
+        assert robot.state().pose.x < 0.9

@@ -11,10 +11,13 @@ from agent.ros2.config import RosConfig
 from agent.ros2.geometry import footprint_radius, quaternion_from_yaw, wrap_angle, yaw_from_quaternion
 from agent.ros2.goal_follower import Goal, GoalFollower
 from agent.ros2.messages import (
+    BumperStop,
     Footprint,
     FormatError,
+    decode_bumper,
     decode_held,
     decode_objects,
+    encode_bumper,
     encode_held,
     encode_objects,
 )
@@ -51,6 +54,26 @@ def test_malformed_object_reports_say_what_is_wrong(text: str, complaint: str) -
 def test_a_grasp_reply_without_held_is_rejected() -> None:
     with pytest.raises(FormatError, match="expected"):
         decode_held('{"ok": true}', "grasp reply")
+
+
+def test_bumper_stops_round_trip_and_may_leave_out_what_the_robot_cannot_tell() -> None:
+    stop = BumperStop("table", (2.6, -0.2), "map")
+    assert decode_bumper(encode_bumper(stop), "test") == stop
+    assert decode_bumper("{}", "test") == BumperStop()
+    assert decode_bumper('{"obstacle": "", "x": 1, "y": 2}', "test") == BumperStop(None, (1.0, 2.0))
+
+
+@pytest.mark.parametrize(("text", "complaint"), [
+    ("bump!", "not the documented JSON"),
+    ('{"obstacle": 3}', "`obstacle` must be an object name or null, got 3"),
+    ('{"obstacle": "table", "x": 2.6}', "`x` and `y` must both be numbers or both be left out"),
+    ('{"x": "near", "y": 0}', "`x` and `y` must both be numbers"),
+    ('{"x": "inf", "y": 0}', "not finite"),
+])
+def test_malformed_bumper_stops_say_what_is_wrong(text: str, complaint: str) -> None:
+    with pytest.raises(FormatError, match="bumper topic /bumper") as error:
+        decode_bumper(text, "bumper topic /bumper")
+    assert complaint in str(error.value)
 
 
 def test_ros_config_reads_the_profile_and_rejects_bad_values(profile: Profile) -> None:
