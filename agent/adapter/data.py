@@ -21,6 +21,7 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
 from agent.adapter.prompt import adapter_prompt, program_objects
+from agent.corrections import CORRECTIONS
 from agent.normalize import normalize_task
 from rsl.plan import Command, ObjectRef, Plan, Quantity, format_number
 from rsl.profile import Convention, Profile, Skill
@@ -181,8 +182,6 @@ OPENERS = ("robot, ", "hey robot, ", "okay robot, ", "robot ", "please ", "could
            "thanks, now ", "ok so ", "so ", "right, ", "hey, ", "buddy, ", "listen, ", "when you're ready, ")
 CLOSERS = (", please", " please", ", thanks", ", thank you", " now", " for me", ", that's all",
            " and that's it", ", ok?", " when you're ready", ", robot", " right away", " if you can")
-CORRECTIONS = (", no, {b}", ", sorry, {b}", ", i mean {b}", ", no wait, {b}", ", make that {b}",
-               ", actually {b}", ", oops, {b}", ", no sorry, {b}", " - no, {b}", ", or rather {b}")
 AFTER = ("after you {x}, {y}", "once you {x}, {y}", "{y} after you {x}", "{y}, but first {x}",
          "before you {y}, {x}", "{y}, but before that {x}",
          "first {x}, and when that's done {y}", "{x}, and once you're done {y}", "{x} and afterwards {y}",

@@ -23,6 +23,7 @@ from collections import Counter
 from collections.abc import Collection, Iterable
 from dataclasses import dataclass
 
+from agent.corrections import MARKERS
 from agent.translate.clauses import _SHAPES
 from agent.translate.explain import quantity, say
 from rsl.compiler import compile_program
@@ -33,6 +34,10 @@ _WORD = re.compile(r"[a-z]+")
 _NUMBER_UNIT = re.compile(r"(?<![\w.])(-?\d*\.?\d+)(?: (m|rad)\b)?")
 _COUNT = re.compile(r"\b(\d+) times\b")
 _CLAUSE_START = re.compile(r"(?:^|[,.;]|\band\b|\bthen\b)\s*([a-z]+)")
+# What a self-correction takes back: the number or the word right before its marker, when another follows.
+_CORRECTED = rf",?\s+(?:{'|'.join(MARKERS)}),?\s+(?:the |a |an )?"
+_TAKEN_BACK_NUMBER = re.compile(rf"(?<![\w.])(-?\d*\.?\d+)(?: (?:m|rad)\b)?{_CORRECTED}(?=-?\d*\.?\d)")
+_TAKEN_BACK_WORD = re.compile(rf"\b([a-z]+){_CORRECTED}([a-z]+)")
 _FIRST_CLAUSE = re.compile(r"[.;]")
 # What negates what follows it up to the end of its clause ("don't move, just look left").
 _NEGATION = re.compile(r"\b(?:don'?t|do not|never|without|no|not)\b[^,.;]*")
@@ -278,9 +283,10 @@ def _directions(plan: Plan, vocab: _Vocabulary, words: set[str], profile: Profil
 
 
 def _said_numbers(text: str) -> list[tuple[float, str]]:
-    counts = {m.start(1) for m in _COUNT.finditer(text)}
+    """The amounts said, less counts ("3 times") and numbers taken back ("1 m, no, 2 m")."""
+    dropped = {m.start(1) for m in _COUNT.finditer(text)} | {m.start(1) for m in _TAKEN_BACK_NUMBER.finditer(text)}
     return [(abs(float(m.group(1))), m.group(2) or "") for m in _NUMBER_UNIT.finditer(text)
-            if m.start(1) not in counts]
+            if m.start(1) not in dropped]
 
 
 def _counts(text: str) -> int:
@@ -432,6 +438,8 @@ def _vague_amount(text: str, vocab: _Vocabulary, unit: str) -> float:
 
 def _objects(text: str, plan: Plan, known: Collection[str] | None, vocab: _Vocabulary) -> list[Doubt]:
     """Every object in the plan was said, and every known object said is in the plan."""
+    known_words = {w for name in known or () for w in name.lower().split("_")}
+    taken_back = {m.group(1) for m in _TAKEN_BACK_WORD.finditer(text) if m.group(2) in known_words}
     words = set(_WORD.findall(text))
     planned = {a.name for c in plan for a in c.args if isinstance(a, ObjectRef)}
     doubts = []
@@ -443,6 +451,7 @@ def _objects(text: str, plan: Plan, known: Collection[str] | None, vocab: _Vocab
             doubts.append(Doubt("object", f"the plan uses the {name.replace('_', ' ')}, which you did not mention"))
     for name in sorted(known or ()) if planned else ():
         parts = name.lower().split("_")
-        if all(p in words for p in parts) and not any(set(parts) <= set(p.split("_")) for p in planned):
+        if (all(p in words for p in parts) and not set(parts) & taken_back
+                and not any(set(parts) <= set(p.split("_")) for p in planned)):
             doubts.append(Doubt("object", f"you mentioned the {name.replace('_', ' ')}, but the plan never uses it"))
     return doubts

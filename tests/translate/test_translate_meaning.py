@@ -87,6 +87,9 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
     ("go a bit further", "forward 1;", 'you said "a bit further" (0.5 m), but the plan does not do that'),
     ("turn your head to the left, then head to the table", "turnleft 1.5708; approach table;",
      "you asked about the head, but the plan never uses it"),
+    ("drive one meter, i mean two meters", "forward 1; forward 2;",
+     "you said 2 m of distance in all, but the plan drives 3 m"),
+    ("drive one meter, i mean two meters", "forward 1;", "you said 2 m, but the plan never uses it"),
 ])
 def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str, expected: str,
                                                          profile: Profile) -> None:
@@ -126,6 +129,9 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     # A part's noun first in its clause is a verb.
     ("head over to the table", "approach table;"),
     ("robot, head back to where you started", "goto 0, 0;"),
+    # What a self-correction takes back need not be in the plan.
+    ("go forward one meter, no wait, two meters", "forward 2;"),
+    ("grab the cup, no, the keys", "grasp keys;"),
 ])
 def test_a_plan_that_does_what_was_said_has_no_doubt(task: str, program: str, profile: Profile) -> None:
     assert reasons(task, program, profile, ["cup", "table", "keys"]) == []

@@ -1,0 +1,16 @@
+"""How a speaker takes back what they just said ("1 meter, no, 2 meters").
+
+One list for the two places that read it: the training data writes
+self-corrections with these templates, and the meaning checks take back a
+number or an object said right before one of their markers.
+"""
+
+from __future__ import annotations
+
+import re
+
+CORRECTIONS = (", no, {b}", ", sorry, {b}", ", i mean {b}", ", no wait, {b}", ", make that {b}",
+               ", actually {b}", ", oops, {b}", ", no sorry, {b}", " - no, {b}", ", or rather {b}")
+# The words of each template, longest first so that "no wait" is read before "no".
+MARKERS = tuple(sorted({re.sub(r"[^a-z ]", "", t.replace("{b}", "")).strip() for t in CORRECTIONS},
+                       key=len, reverse=True))
