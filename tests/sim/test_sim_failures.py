@@ -172,6 +172,15 @@ def test_a_skill_without_a_binding_fails_clearly(robot: SimRobot) -> None:
     assert "the skill `wave` declares no binding" in result.outcomes[1].reason
 
 
+def test_the_simulator_itself_refuses_a_skill_without_a_binding(robot: SimRobot) -> None:
+    wave = '\n[[skills]]\nkeyword = "wave"\ndescription = "Wave."\nexample = "wave;"\nparams = []\n'
+    waving = parse_profile(default_profile_path().read_text(encoding="utf-8") + wave)
+    skill = waving.skill("wave")
+    assert skill is not None
+    outcome = robot.perform(skill, ())
+    assert outcome == Outcome.failed("the sim backend cannot run `wave`: it declares no binding in profile default")
+
+
 def test_a_skill_bound_to_ros_runs_in_the_simulator_as_not_simulated(robot: SimRobot) -> None:
     dock = ('\n[[skills]]\nkeyword = "dock"\ndescription = "Dock."\nexample = "dock;"\nparams = []\n'
             'binding = { ros = "trigger", service = "/dock" }\n')
