@@ -26,7 +26,7 @@ import threading
 import time
 from collections.abc import Callable
 
-from agent.executor import navigate_point
+from agent.primitives import primitive_step
 from agent.robot import CancelToken, Outcome, Pose, RobotState, SkillCalls, approach_first
 from agent.ros2.bindings import BindingFailure, BoundSkills
 from agent.ros2.config import RosConfig
@@ -102,23 +102,7 @@ class Ros2Robot(SkillCalls):
         if binding is None:
             return Outcome.failed(f"the ROS 2 backend cannot run `{skill.keyword}`: it declares no binding in "
                                   f"profile {self.profile.name}")
-        sign, statement = binding.sign, f"`{skill.keyword}{' ' if args else ''}{', '.join(map(str, args))};`"
-        if binding.name == "drive":
-            return self._guarded(cancel, lambda token: self._drive(float(args[0]), sign, token, statement))
-        if binding.name == "turn":
-            return self._guarded(cancel, lambda token: self._turn(float(args[0]), sign, token, statement))
-        if binding.name == "pan":
-            return self._guarded(cancel, lambda token: self._look(sign * float(args[0]), 0.0, token))
-        if binding.name == "tilt":
-            return self._guarded(cancel, lambda token: self._look(0.0, sign * float(args[0]), token))
-        if binding.name == "navigate":
-            x, y = navigate_point(skill, [float(a) for a in args])
-            return self._guarded(cancel, lambda token: self._navigate(x, y, token, statement))
-        if binding.name == "approach_object":
-            return self._guarded(cancel, lambda token: self._approach(str(args[0]), token))
-        if binding.name == "perceive_objects":
-            return self._guarded(cancel, self._perceive)
-        return self._guarded(cancel, lambda token: self._grasp(str(args[0]), token))
+        return self._guarded(cancel, primitive_step(self, skill, binding, args))
 
     def _navigate(self, x: float, y: float, token: CancelToken, statement: str) -> Outcome:
         self._check_workspace(x, y, statement)

@@ -21,7 +21,8 @@ import math
 import threading
 from collections.abc import Callable
 
-from agent.executor import navigate_point, travel_time
+from agent.executor import travel_time
+from agent.primitives import primitive_step
 from agent.robot import CancelToken, Outcome, Pose, RobotState, SkillCalls, approach_first
 from agent.sim.scene import Scene
 from agent.sim.world import GRASP_BEARING, Contact, SimWorld
@@ -81,25 +82,11 @@ class SimRobot(SkillCalls):
         if binding is None:
             return Outcome.failed(f"the sim backend cannot run `{skill.keyword}`: it declares no binding in "
                                   f"profile {self.profile.name}")
-        sign = binding.sign
-        if binding.name == "drive":
-            return self._run(cancel, lambda token: self._drive(sign * float(args[0]), token))
-        if binding.name == "turn":
-            return self._run(cancel, lambda token: self._turn(sign * float(args[0]), token))
-        if binding.name == "pan":
-            return self._run(cancel, lambda token: self._look(sign * float(args[0]), 0.0, token))
-        if binding.name == "tilt":
-            return self._run(cancel, lambda token: self._look(0.0, sign * float(args[0]), token))
-        if binding.name == "navigate":
-            x, y = navigate_point(skill, [float(a) for a in args])
-            return self._run(cancel, lambda token: self._navigate(x, y, token))
-        if binding.name == "approach_object":
-            return self._run(cancel, lambda token: self._approach(str(args[0]), token))
-        if binding.name == "perceive_objects":
-            return self._run(cancel, self._perceive)
-        return self._run(cancel, lambda token: self._grasp(str(args[0]), token))
+        # The simulator words its failures by motion ("driving backward"), so its operations leave the
+        # statement they are given unused.
+        return self._run(cancel, primitive_step(self, skill, binding, args))
 
-    def _navigate(self, x: float, y: float, token: CancelToken) -> Outcome:
+    def _navigate(self, x: float, y: float, token: CancelToken, _what: str) -> Outcome:
         self._check_workspace(x, y, f"the point ({x:g}, {y:g})")
         self._drive_to(x, y, token)
         pose = self.world.base_pose()
@@ -304,9 +291,9 @@ class SimRobot(SkillCalls):
             if world.blocked_by is not None:
                 raise _Blocked(_bumped(what, world.blocked_by, abs(left), unit))
 
-    def _drive(self, distance: float, token: CancelToken) -> Outcome:
+    def _drive(self, distance: float, sign: float, token: CancelToken, _what: str) -> Outcome:
         start = self.world.base_pose()
-        self._drive_line(start, start.heading, distance, token, None)
+        self._drive_line(start, start.heading, sign * distance, token, None)
         pose = self.world.base_pose()
         travelled = math.hypot(pose.x - start.x, pose.y - start.y)
         return Outcome.done(f"moved {travelled:.3f} m")
@@ -334,7 +321,10 @@ class SimRobot(SkillCalls):
         self._settle(remaining, command, LINEAR_TOLERANCE, motion.max_linear_speed, motion.max_linear_accel,
                      distance, token, what, "m")
 
-    def _turn(self, angle: float, token: CancelToken) -> Outcome:
+    def _turn(self, angle: float, sign: float, token: CancelToken, _what: str) -> Outcome:
+        return self._turn_by(sign * angle, token)
+
+    def _turn_by(self, angle: float, token: CancelToken) -> Outcome:
         world, motion = self.world, self.profile.motion
         turned = 0.0
         last = world.base_pose().heading
@@ -353,7 +343,7 @@ class SimRobot(SkillCalls):
 
     def _turn_to(self, heading: float, token: CancelToken) -> None:
         now = self.world.base_pose().heading
-        self._turn(math.remainder(heading - now, 2 * math.pi), token)
+        self._turn_by(math.remainder(heading - now, 2 * math.pi), token)
 
     def _drive_to(self, x: float, y: float, token: CancelToken) -> None:
         pose = self.world.base_pose()
