@@ -25,6 +25,9 @@ from .conftest import Bridge, Probe
 REALTIME_FACTOR = 1.0
 STOP_WITHIN = 0.2  # s, from the issue: the robot stops within 0.2 s of a cancel
 STILL = 0.01  # m/s
+# A zero Twist reaches the bridge's next tick (20 ms) and the odometry after it reaches the probe
+# within this, with room for a loaded machine.
+STOP_REACHES = 0.15  # s
 
 
 def start_in_background(step: Callable[[], Outcome]) -> tuple[threading.Thread, list[Outcome]]:
@@ -239,8 +242,12 @@ def test_a_motion_into_the_table_fails_at_the_bumper_naming_it(
                     "the base; the bumper stopped the base before it pushed the table. Go around the table or "
                     "back away from it first.$", outcome.reason), outcome.reason
     # The bumper cuts the drive from full speed at once; the motors' ramp would take five ticks.
-    bumped = [o for o in probe.odoms if o.x > 2.0 and abs(o.linear) < 0.1]
-    assert bumped, "odometry never showed the bumper stopping the base"
+    # The probe's odometry can trail the backend's on a loaded machine, so it gets a moment to arrive.
+    deadline = time.monotonic() + 2.0
+    while not (bumped := [o for o in probe.odoms if o.x > 2.0 and abs(o.linear) < 0.1]):
+        assert time.monotonic() < deadline, ("odometry never showed the bumper stopping the base: last (x, m/s) "
+                                             f"{[(round(o.x, 3), round(o.linear, 3)) for o in probe.odoms[-8:]]}")
+        time.sleep(0.01)
     assert failed_at - bumped[0].at < 0.3, f"failed {failed_at - bumped[0].at:.2f} s after the bumper stop"
     assert 2.3 < robot.state().pose.x < 2.36
     # The base may creep on towards the table until the backend's stop reaches it, never after.
@@ -248,7 +255,11 @@ def test_a_motion_into_the_table_fails_at_the_bumper_naming_it(
     zeros = [t for t in probe.twists if t.at >= bumped[0].at and not (t.linear or t.angular)]
     assert zeros and zeros[0].at - bumped[0].at < 0.2, "no zero Twist followed the bumper stop"
     assert not [t for t in probe.twists if t.at > zeros[0].at and (t.linear or t.angular)]
-    assert all(abs(o.linear) < STILL for o in probe.odoms if o.at > failed_at), "the base moved after the failure"
+    # Odometry sent before the zero Twist reached the bridge may still show that creep; none after.
+    reached = zeros[0].at + STOP_REACHES
+    moved = [(round(o.at - reached, 3), round(o.x, 3), round(o.linear, 3)) for o in probe.odoms
+             if o.at > reached and abs(o.linear) >= STILL]
+    assert not moved, f"the base moved after the stop: (s after, x, m/s) {moved[:8]}"
     # Reports of that stop still in flight must not fail the next step, which backs away.
     assert robot.backward(0.5).ok
 
