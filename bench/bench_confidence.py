@@ -36,8 +36,7 @@ from agent.evalsuite.runner import percentile
 from agent.evalsuite.suite import accepts, suite_path
 from agent.normalize import normalize_task
 from agent.translate import Translator
-from agent.translate.confidence import UNSURE_BELOW, judge
-from agent.translate.meaning import check_meaning
+from agent.translate.confidence import UNSURE_BELOW, assess, result_fields
 from rsl.profile import load_profile
 
 
@@ -84,10 +83,10 @@ def main() -> int:
         if result.plan is not None:
             # The checks, explanation and confidence again, timed alone and side by side with the translation.
             begin = time.perf_counter()
-            judge(normalize_task(task.task), result.plan, profile, (), task.objects)
+            assessment = assess(normalize_task(task.task), result.plan, profile, known_objects=task.objects)
+            result_fields(result.plan, profile, assessment)
             checks_ms.append((time.perf_counter() - begin) * 1000)
-            checks = sorted({d.check for d in check_meaning(normalize_task(task.task), result.plan, profile,
-                                                            task.objects)})
+            checks = sorted({d.check for d in assessment.doubts})
         rows.append({"task": task.task, "group": task.group, "refuse": task.refuse, "program": result.program,
                      "verified": result.verified, "right": accepts(task, result.plan, profile),
                      "confidence": result.confidence, "confirm": result.confirm, "refused": result.refused,
