@@ -89,12 +89,14 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     negated = " ".join(m.group(0) for m in _NEGATION.finditer(text))
     affirmed = _NEGATION.sub(" ", text)
     words = _words(affirmed, vocab)
+    # The conventions named anywhere bound and allow; only those named outside a negation must be done.
+    named = _named(_WORD.findall(text), vocab)
     doubts: list[Doubt] = []
-    doubts += _parts(plan, vocab, words, set(_WORD.findall(negated)), text, profile)
+    doubts += _parts(plan, vocab, words, set(_WORD.findall(negated)), named, profile)
     doubts += _directions(plan, vocab, words, profile)
     doubts += _numbers(text, plan, vocab, profile)
-    doubts += _totals(text, plan, vocab)
-    doubts += _carried_out(_WORD.findall(affirmed), text, plan, vocab)
+    doubts += _totals(text, plan, vocab, named)
+    doubts += _carried_out(_named(_WORD.findall(affirmed), vocab), text, plan, vocab)
     doubts += _objects(text, plan, known_objects, vocab)
     return tuple({d.reason: d for d in doubts}.values())
 
@@ -245,12 +247,11 @@ def _said(words: Iterable[str], direction: frozenset[str]) -> bool:
                for w in words for d in direction)
 
 
-def _parts(plan: Plan, vocab: _Vocabulary, words: set[str], negated: set[str], text: str,
+def _parts(plan: Plan, vocab: _Vocabulary, words: set[str], negated: set[str], named: list[_Convention],
            profile: Profile) -> list[Doubt]:
     """The base moves only when asked for motion; a request about the head moves only the head."""
     used = {vocab.parts.get(c.skill, WHOLE) for c in plan}
-    tokens = _WORD.findall(text)
-    allowed = {skill for c in vocab.conventions if _names(tokens, c, vocab) for skill in c.skills}
+    allowed = {skill for c in named for skill in c.skills}
     asked = {part for part, ws in vocab.part_words.items() if words & ws}
     doubts = []
     for part in sorted(used):
@@ -332,7 +333,7 @@ def _numbers(text: str, plan: Plan, vocab: _Vocabulary, profile: Profile) -> lis
     return doubts
 
 
-def _totals(text: str, plan: Plan, vocab: _Vocabulary) -> list[Doubt]:
+def _totals(text: str, plan: Plan, vocab: _Vocabulary, named: list[_Convention]) -> list[Doubt]:
     """The whole turn and the whole drive of the base fit what was said."""
     count = _counts(text)
     said = _said_numbers(text)
@@ -345,13 +346,13 @@ def _totals(text: str, plan: Plan, vocab: _Vocabulary) -> list[Doubt]:
         said_total = sum(v for v, u in said if u == unit)
         counted = said_total > 0 and _COUNT.search(text) is not None
         if said_total == 0:
-            said_total = _vague_amount(text, vocab, unit)
+            said_total = _vague_amount(named, vocab, unit)
         limit = said_total * count
         # Without a said count and amount a turn may fairly come out as up to a full circle
         # ("spin around"); with both, one repetition too many is what goes wrong.
         floor = 2 * math.pi if unit == "rad" and not counted else 0.0
         if counted:
-            limit += _conventions_said(text, vocab, unit)
+            limit += _conventions_said(named, unit)
         if planned > max(limit, floor) * 1.01 + _TOLERANCE:
             doubts.append(Doubt("total", f"you said {quantity(Quantity(limit, unit))} of {noun} in all, "
                                          f"but the plan {verb} {quantity(Quantity(planned, unit))}"))
@@ -389,13 +390,12 @@ def _same(token: str, word: str) -> bool:
     return token == word or (len(word) >= 5 and token.startswith(word.rstrip("e")))
 
 
-def _named_amounts(text: str, vocab: _Vocabulary) -> list[dict[str, frozenset[float]]]:
-    """The amounts of the conventions the task names, one per convention."""
-    tokens = _WORD.findall(text)
-    return [c.amounts for c in vocab.conventions if _names(tokens, c, vocab)]
+def _named(tokens: list[str], vocab: _Vocabulary) -> list[_Convention]:
+    """The conventions these words name."""
+    return [c for c in vocab.conventions if _names(tokens, c, vocab)]
 
 
-def _carried_out(tokens: list[str], text: str, plan: Plan, vocab: _Vocabulary) -> list[Doubt]:
+def _carried_out(named: list[_Convention], text: str, plan: Plan, vocab: _Vocabulary) -> list[Doubt]:
     """A convention the task names is done: a whole command's skills (or their opposites), and its amount.
 
     The amount is looked for only in units the task gives no number in, and
@@ -408,8 +408,8 @@ def _carried_out(tokens: list[str], text: str, plan: Plan, vocab: _Vocabulary) -
     planned = [(abs(a.value), a.unit) for c in plan if c.skill not in vocab.coordinates
                for a in c.args if isinstance(a, Quantity)]
     doubts = []
-    for convention in vocab.conventions:
-        if convention.default or not _names(tokens, convention, vocab):
+    for convention in named:
+        if convention.default:
             continue
         missing = convention.whole and any(s not in skills and vocab.opposites.get(s) not in skills
                                            for s in convention.skills)
@@ -423,16 +423,14 @@ def _carried_out(tokens: list[str], text: str, plan: Plan, vocab: _Vocabulary) -
     return doubts
 
 
-def _conventions_said(text: str, vocab: _Vocabulary, unit: str) -> float:
+def _conventions_said(named: list[_Convention], unit: str) -> float:
     """What the conventions named in the task add ("then turn around": 180°)."""
-    return sum(max(values.get(unit, (0.0,))) for values in _named_amounts(text, vocab))
+    return sum(max(c.amounts.get(unit, (0.0,))) for c in named)
 
 
-def _vague_amount(text: str, vocab: _Vocabulary, unit: str) -> float:
+def _vague_amount(named: list[_Convention], vocab: _Vocabulary, unit: str) -> float:
     """The most a task that says no number may mean: its conventions' amounts, else the defaults'."""
-    used = _named_amounts(text, vocab)
-    if not used:
-        used = [c.amounts for c in vocab.conventions if c.default]
+    used = [c.amounts for c in named] or [c.amounts for c in vocab.conventions if c.default]
     return max((v for values in used for v in values.get(unit, ())), default=0.0)
 
 
