@@ -22,7 +22,7 @@ from typing import Any
 from agent.ros2.config import RosConfig
 from agent.ros2.geometry import quaternion_from_yaw, wrap_angle, yaw_from_quaternion
 from agent.ros2.goal_follower import Goal, GoalFollower
-from agent.ros2.link import primitives_used
+from agent.ros2.link import interfaces_needed, primitives_used
 from agent.ros2.messages import BumperStop, Footprint, encode_bumper, encode_held, encode_objects
 from agent.ros2.node_thread import NodeThread
 from agent.sim.world import GRASP_BEARING, SimWorld
@@ -65,16 +65,16 @@ class SimBridge:
         # The drivers of the primitives the profile's skills are bound to, and no others: a
         # base-only robot's bridge offers no head or gripper. Skills bound to ROS 2 directly are
         # the robot's own interfaces, which the simulator does not model.
-        used = primitives_used(profile)
-        self._head_joints = bool(used & {"pan", "tilt"})
-        self._has_gripper = "grasp_object" in used
+        needed = interfaces_needed(primitives_used(profile))
+        self._head_joints = "head" in needed
+        self._has_gripper = "gripper" in needed
         self._odom = node.create_publisher(Odometry, cfg.odom, reliable)
         self._joints = node.create_publisher(JointState, cfg.joint_states, reliable)
         self._objects = node.create_publisher(String, cfg.objects_topic, reliable)
         self._bumper = node.create_publisher(String, cfg.bumper, reliable)
         node.create_subscription(Twist, cfg.cmd_vel, self._on_cmd_vel, reliable)
         self.interfaces = [cfg.cmd_vel, cfg.odom, cfg.joint_states, cfg.objects_topic, cfg.bumper]
-        if used & {"navigate", "approach_object"}:
+        if "goal" in needed:
             node.create_subscription(PoseStamped, cfg.goal_pose, self._on_goal, reliable)
             self.interfaces.append(cfg.goal_pose)
         if self._head_joints:
@@ -84,7 +84,7 @@ class SimBridge:
             node.create_subscription(JointTrajectory, cfg.gripper_trajectory, self._on_gripper, reliable)
             node.create_service(Trigger, cfg.grasp_service, self._on_grasp)
             self.interfaces += [cfg.gripper_trajectory, cfg.grasp_service]
-        if used & {"perceive_objects", "approach_object"}:
+        if "perceive" in needed:
             node.create_service(Trigger, cfg.perceive_service, self._on_perceive)
             self.interfaces.append(cfg.perceive_service)
         node.create_service(Trigger, RESET_SERVICE, self._on_reset)

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 from dataclasses import dataclass
 from typing import Any
 
@@ -75,14 +75,14 @@ class RobotLink:
         self._pose_type = PoseStamped
         self._trajectory_type = JointTrajectory
         self._reliable = reliable
-        # Only the interfaces the profile's primitives use: a base-only robot offers no head topic.
+        needed = interfaces_needed(primitives)
         self._cmd_vel = node.create_publisher(Twist, config.cmd_vel, reliable)
         self._publishers: dict[str, Any] = {"cmd_vel": self._cmd_vel}
-        if primitives & {"navigate", "approach_object"}:
+        if "goal" in needed:
             self._publishers["goal"] = node.create_publisher(PoseStamped, config.goal_pose, reliable)
-        if primitives & {"pan", "tilt"}:
+        if "head" in needed:
             self._publishers["head"] = node.create_publisher(JointTrajectory, config.head_trajectory, reliable)
-        if "grasp_object" in primitives:
+        if "gripper" in needed:
             self._publishers["gripper"] = node.create_publisher(JointTrajectory, config.gripper_trajectory,
                                                                 reliable)
         # Best-effort subscriptions match both reliable and best-effort publishers,
@@ -93,9 +93,9 @@ class RobotLink:
                                  QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT))
         # Reliable: a bumper stop is an event, not a stream whose next message would make up for a lost one.
         node.create_subscription(String, config.bumper, self._on_bumper, reliable)
-        self._perceive = node.create_client(Trigger, config.perceive_service)
-        self._grasp = (node.create_client(Trigger, config.grasp_service) if "grasp_object" in primitives
-                       else None)
+        self._perceive = (node.create_client(Trigger, config.perceive_service) if "perceive" in needed
+                          else None)
+        self._grasp = node.create_client(Trigger, config.grasp_service) if "gripper" in needed else None
         self._trigger_request = Trigger.Request
 
     # -- incoming --------------------------------------------------------------
@@ -307,6 +307,23 @@ class RobotLink:
 def primitives_used(profile: Profile) -> frozenset[str]:
     """The robot primitives the profile's skills are bound to."""
     return frozenset(s.binding.name for s in profile.skills if isinstance(s.binding, Primitive))
+
+
+# The optional interfaces of the robot and the primitives that use each. The backend opens, and the
+# simulator's bridge offers, one only when a skill is bound to such a primitive: a base-only robot
+# has no head topic. Both read this table, so the two sides cannot disagree on what a robot needs.
+_INTERFACE_USERS = {
+    "goal": frozenset({"navigate", "approach_object"}),
+    "head": frozenset({"pan", "tilt"}),
+    "gripper": frozenset({"grasp_object"}),
+    # Grasping or approaching an object not yet known looks for it first.
+    "perceive": frozenset({"perceive_objects", "approach_object", "grasp_object"}),
+}
+
+
+def interfaces_needed(primitives: Collection[str]) -> frozenset[str]:
+    """Which of "goal", "head", "gripper" (trajectory and grasp service) and "perceive" these primitives use."""
+    return frozenset(name for name, users in _INTERFACE_USERS.items() if users & set(primitives))
 
 
 def distance(a: Pose, x: float, y: float) -> float:

@@ -68,3 +68,33 @@ def test_sim_bridge_rejects_bad_input_with_exit_2(args: list[str], message: str)
     assert done.returncode == 2, done.stderr
     assert message in done.stderr
 
+
+
+def test_a_robot_that_only_grasps_is_offered_the_look_a_grasp_falls_back_on(profile: Profile) -> None:
+    """Grasping an object not yet known calls the perception service first, so the simulator's bridge
+    must offer it for a robot whose perceive and approach skills are bound elsewhere."""
+    from pathlib import Path
+
+    from agent.ros2.bridge import SimBridge
+    from agent.ros2.link import interfaces_needed, primitives_used
+    from agent.sim.scene import load_scene
+    from agent.sim.world import SimWorld
+    from rsl.profile import parse_profile
+
+    text = Path(profile.source).read_text(encoding="utf-8")
+    for primitive, binding in [("perceive_objects", '{ ros = "trigger", service = "/look" }'),
+                               ("approach_object", '{ ros = "topic", topic = "/approach", '
+                                                   'type = "std_msgs/msg/String", fields = { data = "object" } }')]:
+        bound = f'binding = {{ primitive = "{primitive}" }}'
+        assert bound in text
+        text = text.replace(bound, f"binding = {binding}")
+    grasping = parse_profile(text)
+    assert "perceive" in interfaces_needed(primitives_used(grasping))
+    assert "perceive" not in interfaces_needed({"drive", "turn", "navigate"})
+    scene = load_scene()
+    bridge = SimBridge(grasping, lambda: SimWorld(grasping, scene), node_name="nrtrans_test_grasp_only_bridge")
+    try:
+        assert bridge.config.perceive_service in bridge.interfaces
+        assert bridge.config.grasp_service in bridge.interfaces
+    finally:
+        bridge.close()
