@@ -84,7 +84,7 @@ class SimBridge:
             node.create_subscription(JointTrajectory, cfg.gripper_trajectory, self._on_gripper, reliable)
             node.create_service(Trigger, cfg.grasp_service, self._on_grasp)
             self.interfaces += [cfg.gripper_trajectory, cfg.grasp_service]
-        if "perceive" in needed:
+        if "perception" in needed:
             node.create_service(Trigger, cfg.perceive_service, self._on_perceive)
             self.interfaces.append(cfg.perceive_service)
         node.create_service(Trigger, RESET_SERVICE, self._on_reset)

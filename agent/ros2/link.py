@@ -93,7 +93,7 @@ class RobotLink:
                                  QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT))
         # Reliable: a bumper stop is an event, not a stream whose next message would make up for a lost one.
         node.create_subscription(String, config.bumper, self._on_bumper, reliable)
-        self._perceive = (node.create_client(Trigger, config.perceive_service) if "perceive" in needed
+        self._perceive = (node.create_client(Trigger, config.perceive_service) if "perception" in needed
                           else None)
         self._grasp = node.create_client(Trigger, config.grasp_service) if "gripper" in needed else None
         self._trigger_request = Trigger.Request
@@ -317,12 +317,12 @@ _INTERFACE_USERS = {
     "head": frozenset({"pan", "tilt"}),
     "gripper": frozenset({"grasp_object"}),
     # Grasping or approaching an object not yet known looks for it first.
-    "perceive": frozenset({"perceive_objects", "approach_object", "grasp_object"}),
+    "perception": frozenset({"perceive_objects", "approach_object", "grasp_object"}),
 }
 
 
 def interfaces_needed(primitives: Collection[str]) -> frozenset[str]:
-    """Which of "goal", "head", "gripper" (trajectory and grasp service) and "perceive" these primitives use."""
+    """Which of "goal", "head", "gripper" (trajectory and grasp service) and "perception" these primitives use."""
     return frozenset(name for name, users in _INTERFACE_USERS.items() if users & set(primitives))
 
 

@@ -89,8 +89,8 @@ def test_a_robot_that_only_grasps_is_offered_the_look_a_grasp_falls_back_on(prof
         assert bound in text
         text = text.replace(bound, f"binding = {binding}")
     grasping = parse_profile(text)
-    assert "perceive" in interfaces_needed(primitives_used(grasping))
-    assert "perceive" not in interfaces_needed({"drive", "turn", "navigate"})
+    assert "perception" in interfaces_needed(primitives_used(grasping))
+    assert "perception" not in interfaces_needed({"drive", "turn", "navigate"})
     scene = load_scene()
     bridge = SimBridge(grasping, lambda: SimWorld(grasping, scene), node_name="nrtrans_test_grasp_only_bridge")
     try:
