@@ -323,7 +323,8 @@ _INTERFACE_USERS = {
 
 def interfaces_needed(primitives: Collection[str]) -> frozenset[str]:
     """Which of "goal", "head", "gripper" (trajectory and grasp service) and "perception" these primitives use."""
-    return frozenset(name for name, users in _INTERFACE_USERS.items() if users & set(primitives))
+    given = frozenset(primitives)
+    return frozenset(name for name, users in _INTERFACE_USERS.items() if users & given)
 
 
 def distance(a: Pose, x: float, y: float) -> float:

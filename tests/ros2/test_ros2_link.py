@@ -1,5 +1,6 @@
-"""The robot link itself: no robot at all, a robot that shuts down mid-task, and
-`nrtrans sim-bridge` refusing bad input. Each test owns its bridge process."""
+"""The robot link itself: no robot at all, a robot that shuts down mid-task,
+`nrtrans sim-bridge` refusing bad input, and the interfaces a robot's primitives need.
+Each test owns its bridge."""
 
 from __future__ import annotations
 
@@ -8,14 +9,19 @@ import subprocess
 import sys
 import threading
 import time
+from pathlib import Path
 
 import pytest
 
 from agent.backends import open_robot
 from agent.robot import Outcome, Status
 from agent.ros2.backend import RobotUnavailable, Ros2Robot
+from agent.ros2.bridge import SimBridge
 from agent.ros2.config import RosConfig
-from rsl.profile import Profile
+from agent.ros2.link import interfaces_needed, primitives_used
+from agent.sim.scene import load_scene
+from agent.sim.world import SimWorld
+from rsl.profile import Profile, parse_profile
 
 from .conftest import REPO, ROS_ENV, Bridge
 
@@ -69,18 +75,9 @@ def test_sim_bridge_rejects_bad_input_with_exit_2(args: list[str], message: str)
     assert message in done.stderr
 
 
-
 def test_a_robot_that_only_grasps_is_offered_the_look_a_grasp_falls_back_on(profile: Profile) -> None:
     """Grasping an object not yet known calls the perception service first, so the simulator's bridge
     must offer it for a robot whose perceive and approach skills are bound elsewhere."""
-    from pathlib import Path
-
-    from agent.ros2.bridge import SimBridge
-    from agent.ros2.link import interfaces_needed, primitives_used
-    from agent.sim.scene import load_scene
-    from agent.sim.world import SimWorld
-    from rsl.profile import parse_profile
-
     text = Path(profile.source).read_text(encoding="utf-8")
     for primitive, binding in [("perceive_objects", '{ ros = "trigger", service = "/look" }'),
                                ("approach_object", '{ ros = "topic", topic = "/approach", '
