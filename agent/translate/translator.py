@@ -300,7 +300,7 @@ class Translator:
                 continue
             if lines[count:] != lines[count - dropped:count]:
                 continue
-            program = "".join(line + "\n" for line in lines[:count])
+            program = _first_statements(state.program, count)
             passing = self._passing(program, (*state.probabilities[:chosen], probability), normalized, known)
             if passing is None:
                 continue
@@ -563,10 +563,7 @@ def _end_where_weighed(state: _ClauseState, text: str) -> None:
     model's signal, so a doubtful one is asked about, not run.
     """
     count, chosen, probability = max(state.endings, key=lambda e: e[2])
-    cut = 0
-    for _ in range(count):
-        cut = text.index(";", cut) + 1
-    state.program = _tidy(text[:cut] + "\n")
+    state.program = _first_statements(text, count)
     state.probabilities = (*state.probabilities[:chosen], probability)
     state.tokens = state.tokens[:chosen]
     state.forks = tuple(f for f in state.forks if f[0] < chosen)
@@ -597,6 +594,14 @@ def _likely_meant(names: Collection[str], known: Collection[str]) -> tuple[str, 
 def _tidy(text: str) -> str:
     """The generated program with exactly one newline after each line and no blank lines."""
     return "".join(line.rstrip() + "\n" for line in text.splitlines() if line.strip())
+
+
+def _first_statements(text: str, count: int) -> str:
+    """The program's first `count` statements, tidied."""
+    cut = 0
+    for _ in range(count):
+        cut = text.index(";", cut) + 1
+    return _tidy(text[:cut] + "\n")
 
 
 def _assemble(states: list[_ClauseState]) -> str:
