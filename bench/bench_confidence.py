@@ -31,12 +31,15 @@ from collections import Counter
 from pathlib import Path
 from typing import Any
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
 from agent.evalsuite import load_suite
 from agent.evalsuite.runner import percentile
 from agent.evalsuite.suite import accepts, suite_path
 from agent.normalize import normalize_task
 from agent.translate import Translator
 from agent.translate.confidence import UNSURE_BELOW, assess, result_fields
+from bench import SPLIT
 from rsl.profile import load_profile
 
 
@@ -64,7 +67,7 @@ def main() -> int:
     parser.add_argument("--out", default="bench/results/confidence_suite.json")
     parser.add_argument("--adapter", default="default", metavar="PATH",
                         help="adapter GGUF to measure (default: the shipped one)")
-    parser.add_argument("--split", choices=("default", "on", "off"), default="default",
+    parser.add_argument("--split", choices=tuple(SPLIT), default="default",
                         help="clause splitting (default: the translator's default for the adapter)")
     parser.add_argument("--per-task", action="store_true",
                         help="also write each task's outcome (only for sets that may be looked at)")
@@ -73,7 +76,7 @@ def main() -> int:
     profile = load_profile()
     tasks = load_suite(args.suite, profile)[:: max(1, args.every)]
     translator = Translator.load(profile, adapter=args.adapter,
-                                 split_clauses={"default": None, "on": True, "off": False}[args.split])
+                                 split_clauses=SPLIT[args.split])
     rows: list[dict[str, Any]] = []
     checks_ms: list[float] = []
     started = time.monotonic()

@@ -32,9 +32,12 @@ import time
 from pathlib import Path
 from typing import Any
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
 from agent.evalsuite import load_suite
 from agent.evalsuite.runner import render_table, run_suite, summarize
 from agent.translate import Translator
+from bench import SPLIT
 from rsl.profile import load_profile
 
 SETS = {"suite": None, "novel": "bench/novel_tasks.toml", "dev": "bench/fresh/dev.toml",
@@ -64,11 +67,11 @@ def main() -> int:
     parser.add_argument("--sets", default="suite,novel,dev",
                         help=f"with --compare: which of {', '.join(SETS)} to run, or a suite file's path, whose "
                              "per-task results are not kept (default: suite,novel,dev)")
-    parser.add_argument("--split", choices=("default", "on", "off"), default="default",
+    parser.add_argument("--split", choices=tuple(SPLIT), default="default",
                         help="with --compare: clause splitting (default: the translator's default)")
     args = parser.parse_args()
     if args.compare:
-        split = {"default": None, "on": True, "off": False}[args.split]
+        split = SPLIT[args.split]
         return compare(args.compare, [s.strip() for s in args.sets.split(",") if s.strip()], args.every,
                        split, args.out or "bench/results/eval_adapters.json")
     args.out = args.out or "bench/results/eval_side_by_side.json"
