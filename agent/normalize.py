@@ -227,7 +227,20 @@ def _convert_numbers(tokens: list[str]) -> list[str]:
     return out
 
 
+def _u_turn_at(tokens: Sequence[str], i: int) -> int | None:
+    """The index after a U-turn ("a u turn", "uturn") that starts at tokens[i]: half a revolution."""
+    j = i + 1 if tokens[i] in ("a", "an") else i
+    if tokens[j:j + 2] == ["u", "turn"]:
+        return j + 2
+    if tokens[j:j + 1] == ["uturn"]:
+        return j + 1
+    return None
+
+
 def _convert_at(tokens: list[str], i: int) -> tuple[str, int] | None:
+    if (end := _u_turn_at(tokens, i)) is not None:
+        # The verb stays: "make a u-turn" asks the robot to turn.
+        return f"turn {format_number(math.pi)} rad", end
     token = tokens[i]
     parsed = _parse_number(tokens, i)
     if parsed is not None:

@@ -36,6 +36,10 @@ from agent.normalize import normalize_task
         ("go to the point two, five", "go to the point 2, 5"),
         ("do one complete rotation", "do 6.2832 rad"),
         ("spin a whole turn", "spin 6.2832 rad"),
+        # A U-turn is half a turn, as exact as "half a turn".
+        ("make a u-turn", "make turn 3.1416 rad"),
+        ("do a U turn to the right", "do turn 3.1416 rad to the right"),
+        ("pull a uturn then stop", "pull turn 3.1416 rad then stop"),
         # Thanks and corrections carry meaning the model needs: a closing is no task, "i mean" corrects.
         ("cheers, thanks, that's all", "cheers, thanks, that's all"),
         ("turn left, i mean right", "turn left, i mean right"),
