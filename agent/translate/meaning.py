@@ -39,8 +39,10 @@ _CORRECTED = rf",?\s+(?:{'|'.join(MARKERS)}),?\s+(?:the |a |an )?"
 _TAKEN_BACK_NUMBER = re.compile(rf"(?<![\w.])(-?\d*\.?\d+)(?: (?:m|rad)\b)?{_CORRECTED}(?=-?\d*\.?\d)")
 _TAKEN_BACK_WORD = re.compile(rf"\b([a-z]+){_CORRECTED}([a-z]+)")
 _FIRST_CLAUSE = re.compile(r"[.;]")
-# What negates what follows it up to the end of its clause ("don't move, just look left").
-_NEGATION = re.compile(r"\b(?:don'?t|do not|never|without|no|not)\b[^,.;]*")
+# What negates what follows it up to the end of its clause ("don't move, just look left"), and a part
+# kept still ("keep your head still and turn left").
+_NEGATION = re.compile(r"\b(?:don'?t|do not|never|without|no|not)\b[^,.;]*"
+                       r"|\b(?:keep|hold)\s+(?:[a-z]+\s+){0,2}?still\b")
 # The part of the robot that moves itself as a whole: the one a skill is on when its description names no part.
 WHOLE = "base"
 _TOLERANCE = 0.02

@@ -63,6 +63,11 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
     ("pan the head left", "turnleft 1.5708;", "you asked about the head, but the plan moves the base (turn left 90°)"),
     ("don't move, just look left", "turnleft 1.5708; lookleft 0.5236;",
      "you said not to move the base, but the plan does (turn left 90°)"),
+    # Keeping a part still is a negation of moving it.
+    ("keep your head still and rotate the body left", "turnleft 1.5708; lookleft 0.5236;",
+     "you said not to move the head, but the plan does (look left 30°)"),
+    ("hold the camera still, then turn right", "lookright 0.5236; turnright 1.5708;",
+     "you said not to move the head, but the plan does (look right 30°)"),
     ("repeat a turn until a full circle", "turnleft 6.2832; turnleft 6.2832; turnleft 6.2832;",
      "you said 360° of turn in all, but the plan turns 1080°"),
     ("turn right 90 degrees", "turnleft 1.5708;", "you said right, but the plan goes the other way (turn left 90°)"),
