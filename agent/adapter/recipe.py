@@ -20,8 +20,9 @@ class Recipe:
     alpha: float = 32.0
     seed: int = 0
     threads: int = 0  # 0: every core
-    # The frozen base runs in bfloat16 (about 10x faster on CPUs with AMX or
-    # AVX512-BF16, the same on GPUs); the LoRA weights stay float32.
-    bf16: bool = True
+    # The frozen base runs in bfloat16 where the device multiplies it natively (about 10x faster on CPUs
+    # with AMX or AVX512-BF16; GPUs), else in float32: an AVX2-only CPU emulates bfloat16 about 150x
+    # slower than float32. None: choose by the device (`train.native_bf16`); the LoRA weights stay float32.
+    bf16: bool | None = None
     # Also write the adapter every this many steps (`<out>.step<N>.gguf`), for a learning curve; 0: never.
     checkpoint_every: int = 0

@@ -136,7 +136,7 @@ def _train(args: argparse.Namespace) -> int:
         data={"pairs": len(pairs), "encoded": result.examples, "seed": args.seed, "groups": groups,
               "held_out_pairs": len(held_out), "eval_suite_tasks_excluded": len(suite)},
         training={"steps": result.steps, "batch": recipe.batch, "learning_rate": recipe.learning_rate,
-                  "rank": recipe.rank, "alpha": recipe.alpha, "bf16_base": recipe.bf16,
+                  "rank": recipe.rank, "alpha": recipe.alpha, "bf16_base": result.bf16,
                   "first_loss": round(result.first_loss, 4), "final_loss": round(result.final_loss, 4),
                   "loss_every_50": [round(x, 4) for x in result.losses[::50]],
                   "train_seconds": round(result.seconds, 1),

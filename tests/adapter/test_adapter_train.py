@@ -9,7 +9,7 @@ from agent.adapter.card import read_card
 from agent.adapter.data import generate
 from agent.adapter.evaluate import complete, load
 from agent.adapter.recipe import Recipe
-from agent.adapter.train import train
+from agent.adapter.train import native_bf16, train
 from rsl.profile import Profile
 from tests.adapter.conftest import requires
 
@@ -27,6 +27,8 @@ def test_a_few_steps_lower_the_loss_and_change_llama_cpp_output(profile: Profile
     first_epoch, last_epoch = result.losses[:4], result.losses[-4:]
     assert sum(last_epoch) < 0.6 * sum(first_epoch), result.losses
     assert any(line.startswith("step 12/12") and "loss" in line for line in lines)
+    assert f"runs in {'bfloat16' if result.bf16 else 'float32'}" in "\n".join(lines)
+    assert result.bf16 == native_bf16(result.device)
     assert out.stat().st_size > 0
 
     prompt = pairs[0].prompt
@@ -46,3 +48,13 @@ def test_cli_refuses_bad_numbers_and_reads_a_card(tmp_path: Path) -> None:
     path = card.write(tmp_path / "a.json")
     assert read_card(path) == card
     assert json.loads(path.read_text())["licence"].startswith("The adapter is a derivative of Gemma")
+
+
+def test_the_frozen_base_runs_in_bfloat16_only_where_the_device_multiplies_it_natively() -> None:
+    # An AVX2-only CPU emulates bfloat16 about 150 times slower than float32.
+    assert not native_bf16("cpu", "processor\t: 0\nflags\t\t: fpu sse2 avx fma avx2 f16c\n")
+    assert native_bf16("cpu", "flags\t\t: fpu avx2 avx512f avx512_bf16\n")
+    assert native_bf16("cpu", "flags\t\t: fpu avx2 avx512f amx_bf16 amx_tile\n")
+    assert native_bf16("cpu", "Features\t: fp asimd evtstrm bf16 i8mm\n")
+    assert not native_bf16("cpu", "")
+    assert native_bf16("cuda", "")
