@@ -49,7 +49,7 @@ def native_bf16(device: str, cpuinfo: str | None = None) -> bool:
     """Whether `device` multiplies bfloat16 matrices natively (`cpuinfo`: /proc/cpuinfo's text).
 
     Elsewhere torch emulates bfloat16: on an AVX2-only AMD EPYC a product took about 150 times as long
-    as in float32, and the CI-sized training test ran for more than 12 minutes instead of one.
+    as in float32, and the CI-sized training test ran for more than 12 minutes instead of about two.
     """
     if device != "cpu":
         return True
