@@ -46,6 +46,7 @@ from agent.adapter.train import (
     encode,
     load_base,
     model_architecture,
+    native_bf16,
     schedule,
     step_line,
 )
@@ -81,9 +82,11 @@ def main() -> int:
     started = time.monotonic()
     pairs = generate(profile, recipe.pairs, seed=recipe.seed, exclude=held_out_filter(eval_tasks()))
     tokenizer, model = load_base(base)
-    # The frozen rest runs in bfloat16 as in the LoRA recipe; the trained matrices keep float32 masters
-    # and are cast for each product by autocast.
-    model = model.to(torch.bfloat16)
+    # The frozen rest runs in bfloat16 where the CPU multiplies it natively, as in the LoRA recipe; the
+    # trained matrices keep float32 masters and are cast for each product by autocast.
+    bf16 = native_bf16("cpu")
+    if bf16:
+        model = model.to(torch.bfloat16)
     for parameter in model.parameters():
         parameter.requires_grad = False
     trained: dict[str, Any] = {}
@@ -105,7 +108,7 @@ def main() -> int:
     losses: list[float] = []
     training_started = time.monotonic()
     for step, group in enumerate(plan):
-        with torch.autocast("cpu", dtype=torch.bfloat16):
+        with torch.autocast("cpu", dtype=torch.bfloat16, enabled=bf16):
             loss = answer_loss(model, *collate(group, pad, "cpu"))
         loss.backward()
         torch.nn.utils.clip_grad_norm_(list(trained.values()), 1.0)
