@@ -18,6 +18,7 @@ import math
 import re
 from collections.abc import Sequence
 
+from agent.corrections import MARKERS
 from rsl.plan import format_number
 
 _TOKEN = re.compile(r"\d*\.\d+|\d+|[a-z]+(?:'[a-z]+)?|°|,|[.!?;:]")
@@ -72,6 +73,7 @@ def normalize_task(text: str) -> str:
     """Normalize one task; see the module docstring for the output format."""
     tokens = _tokenize(text)
     tokens = _drop_fillers(tokens)
+    tokens = _carry_corrected_units(tokens)
     tokens = _convert_numbers(tokens)
     return _render(tokens)
 
@@ -99,6 +101,36 @@ def _drop_fillers(tokens: list[str]) -> list[str]:
         else:
             out.append(tokens[i])
             i += 1
+    return out
+
+
+_MARKER_WORDS = tuple(tuple(m.split()) for m in MARKERS)
+
+
+def _carry_corrected_units(tokens: list[str]) -> list[str]:
+    """A bare number that corrects an amount takes the amount's unit: "30 degrees, no, 60" is 60 degrees.
+
+    Left bare, the number would reach the model with no unit, and the
+    model copies numbers: it planned a 60 rad turn.
+    """
+    out = list(tokens)
+    for at in range(len(out) - 1, 0, -1):
+        unit = out[at - 1]
+        if unit not in _LENGTHS and unit not in _ANGLES:
+            continue
+        j = at + 1 if out[at:at + 1] == [","] else at
+        marker = next((m for m in _MARKER_WORDS if tuple(out[j:j + len(m)]) == m), None)
+        if marker is None:
+            continue
+        j += len(marker)
+        j += 1 if out[j:j + 1] == [","] else 0
+        parsed = _parse_number(out, j)
+        if parsed is None:
+            continue
+        end = parsed[1]
+        if end < len(out) and (out[end] == "times" or _unit_at(out, end) or _revolutions_at(out, end)):
+            continue
+        out.insert(end, unit)
     return out
 
 

@@ -43,6 +43,12 @@ from agent.normalize import normalize_task
         # Thanks and corrections carry meaning the model needs: a closing is no task, "i mean" corrects.
         ("cheers, thanks, that's all", "cheers, thanks, that's all"),
         ("turn left, i mean right", "turn left, i mean right"),
+        # A bare number that corrects an amount is in the amount's unit.
+        ("turn left 30 degrees, no, 60", "turn left 0.5236 rad, no, 1.0472 rad"),
+        ("move 50 centimeters, make that 80", "move 0.5 m, make that 0.8 m"),
+        ("go forward three meters, no wait, four", "go forward 3 m, no wait, 4 m"),
+        ("turn left 90 degrees, no, 2 times", "turn left 1.5708 rad, no, 2 times"),
+        ("drive 2 meters, no, 3 feet", "drive 2 m, no, 0.9144 m"),
     ],
 )
 def test_normalize_converts_numbers_units_and_fillers(task: str, expected: str) -> None:
