@@ -40,8 +40,8 @@ _TAKEN_BACK_NUMBER = re.compile(rf"(?<![\w.])(-?\d*\.?\d+)(?: (?:m|rad)\b)?{_COR
 _TAKEN_BACK_WORD = re.compile(rf"\b([a-z]+){_CORRECTED}([a-z]+)")
 _FIRST_CLAUSE = re.compile(r"[.;]")
 # What negates what follows it up to the end of its clause ("don't move, just look left"), and a part
-# kept still ("keep your head still and turn left").
-_NEGATION = re.compile(r"\b(?:don'?t|do not|never|without|no|not)\b[^,.;]*"
+# kept still ("keep your head still and turn left"). "why don't you look up" suggests, not negates.
+_NEGATION = re.compile(r"(?<!\bwhy )\b(?:don'?t|do not|never|without|no|not)\b[^,.;]*"
                        r"|\b(?:keep|hold)\s+(?:[a-z]+\s+){0,2}?still\b")
 # The part of the robot that moves itself as a whole: the one a skill is on when its description names no part.
 WHOLE = "base"
@@ -436,22 +436,41 @@ def _vague_amount(named: list[_Convention], vocab: _Vocabulary, unit: str) -> fl
     return max((v for values in used for v in values.get(unit, ())), default=0.0)
 
 
+# A negation word that also starts a self-correction ("no, the keys") corrects rather than denies.
+_CORRECTING = frozenset(m.split()[0] for m in MARKERS)
+
+
+def _spliced_out(text: str, spans: Iterable[re.Match[str]]) -> str:
+    """`text` with the matched spans blanked."""
+    out = text
+    for m in sorted(spans, key=lambda m: m.start(), reverse=True):
+        out = out[:m.start()] + " " + out[m.end():]
+    return out
+
+
 def _objects(text: str, plan: Plan, known: Collection[str] | None, vocab: _Vocabulary) -> list[Doubt]:
     """Every object in the plan was said, and every known object said is in the plan."""
     known_words = {w for name in known or () for w in name.lower().split("_")}
     taken_back = {m.group(1) for m in _TAKEN_BACK_WORD.finditer(text) if m.group(2) in known_words}
     words = set(_WORD.findall(text))
+    # "not the chair" denies an object; "no, the keys" corrects to one.
+    denials = [m for m in _NEGATION.finditer(text) if _WORD.findall(m.group(0))[0] not in _CORRECTING]
+    denied = {w for m in denials for w in _WORD.findall(m.group(0))}
+    affirmed = set(_WORD.findall(_spliced_out(text, denials)))
     planned = {a.name for c in plan for a in c.args if isinstance(a, ObjectRef)}
     doubts = []
     for name in sorted(planned):
+        name_words = set(name.lower().split("_"))
         if name.lower() in vocab.skill_words:
             doubts.append(Doubt("object", f"the plan takes '{name}' for an object, but it names a direction "
                                           "or an action"))
-        elif not (set(name.lower().split("_")) & words):
+        elif not (name_words & words):
             doubts.append(Doubt("object", f"the plan uses the {name.replace('_', ' ')}, which you did not mention"))
+        elif not name_words <= affirmed and name_words <= denied:
+            doubts.append(Doubt("negation", f"you said not the {name.replace('_', ' ')}, but the plan uses it"))
     for name in sorted(known or ()) if planned else ():
         parts = name.lower().split("_")
-        if (all(p in words for p in parts) and not set(parts) & taken_back
+        if (all(p in affirmed for p in parts) and not set(parts) & taken_back
                 and not any(set(parts) <= set(p.split("_")) for p in planned)):
             doubts.append(Doubt("object", f"you mentioned the {name.replace('_', ' ')}, but the plan never uses it"))
     return doubts

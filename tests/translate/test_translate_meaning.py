@@ -95,6 +95,10 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
     ("drive one meter, i mean two meters", "forward 1; forward 2;",
      "you said 2 m of distance in all, but the plan drives 3 m"),
     ("drive one meter, i mean two meters", "forward 1;", "you said 2 m, but the plan never uses it"),
+    # An object said only to deny it is not the one meant.
+    ("go to the table, not the chair", "approach chair;", "you said not the chair, but the plan uses it"),
+    ("grab the red cup, not the blue cup", "grasp blue_cup;", "you said not the blue cup, but the plan uses it"),
+    ("don't drive 2 meters", "forward 2;", "you said not to move the base, but the plan does (drive forward 2 m)"),
 ])
 def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str, expected: str,
                                                          profile: Profile) -> None:
@@ -137,6 +141,13 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     # What a self-correction takes back need not be in the plan.
     ("go forward one meter, no wait, two meters", "forward 2;"),
     ("grab the cup, no, the keys", "grasp keys;"),
+    ("go to the table, not the chair", "approach table;"),
+    ("pick up the keys, not the cup", "grasp keys;"),
+    ("grab the cup no the keys", "grasp keys;"),
+    ("grab the red cup, not the blue cup", "grasp red_cup;"),
+    # A suggestion is a request, not a negation.
+    ("why don't you look up", "lookup 0.5236;"),
+    ("why not turn left", "turnleft 1.5708;"),
 ])
 def test_a_plan_that_does_what_was_said_has_no_doubt(task: str, program: str, profile: Profile) -> None:
     assert reasons(task, program, profile, ["cup", "table", "keys"]) == []
