@@ -33,6 +33,8 @@ from rsl.profile import Profile
 _WORD = re.compile(r"[a-z]+")
 _NUMBER_UNIT = re.compile(r"(?<![\w.])(-?\d*\.?\d+)(?: (m|rad)\b)?")
 _COUNT = re.compile(r"\b(\d+) times\b")
+# A step said after a count: "3 times then turn right", "twice and look up".
+_STEP_AFTER = re.compile(r",?\s*(?:and\s+then|and|then)\s+[a-z]")
 _CLAUSE_START = re.compile(r"(?:^|[,.;]|\band\b|\bthen\b)\s*([a-z]+)")
 # What a self-correction takes back: the number or the word right before its marker, when another follows.
 _CORRECTED = rf",?\s+(?:{'|'.join(MARKERS)}),?\s+(?:the |a |an )?"
@@ -98,6 +100,7 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     doubts += _directions(plan, vocab, words, profile)
     doubts += _numbers(text, plan, vocab, profile)
     doubts += _totals(text, plan, vocab, named)
+    doubts += _repeated_after(text, plan, profile)
     doubts += _carried_out(_named(_WORD.findall(affirmed), vocab), text, plan, vocab)
     doubts += _objects(text, plan, known_objects, vocab)
     return tuple({d.reason: d for d in doubts}.values())
@@ -359,6 +362,25 @@ def _totals(text: str, plan: Plan, vocab: _Vocabulary, named: list[_Convention])
             doubts.append(Doubt("total", f"you said {quantity(Quantity(limit, unit))} of {noun} in all, "
                                          f"but the plan {verb} {quantity(Quantity(planned, unit))}"))
     return doubts
+
+
+def _repeated_after(text: str, plan: Plan, profile: Profile) -> list[Doubt]:
+    """A step said after the count is done once: "forward 1 m 3 times then turn right" repeats only the drive.
+
+    Only the plainest miss is read: one count, a step after it, and a plan
+    that is a block of several steps repeated exactly that many times.
+    """
+    counts = list(_COUNT.finditer(text))
+    if len(counts) != 1 or not _STEP_AFTER.match(text, counts[0].end()):
+        return []
+    times = int(counts[0].group(1))
+    steps = [(c.skill, c.args) for c in plan]
+    size = len(steps) // times if times > 1 else 0
+    if size < 2 or steps != steps[:size] * times:
+        return []
+    block = ", then ".join(say(c, profile) for c in plan.commands[:size])
+    return [Doubt("repetition", f"you said to repeat something {times} times and then go on, but the plan "
+                                f"repeats all of it ({block})")]
 
 
 # How many words may stand between a phrase's own ("turn all the way around" names "turn around").

@@ -95,6 +95,13 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
     ("drive one meter, i mean two meters", "forward 1; forward 2;",
      "you said 2 m of distance in all, but the plan drives 3 m"),
     ("drive one meter, i mean two meters", "forward 1;", "you said 2 m, but the plan never uses it"),
+    # A step said after the count is not part of what repeats.
+    ("go forward one meter three times then turn right", "forward 1; turnright 1.5708; " * 3,
+     "you said to repeat something 3 times and then go on, but the plan repeats all of it "
+     "(drive forward 1 m, then turn right 90°)"),
+    ("look up twice and then turn left", "lookup 0.5236; turnleft 1.5708; " * 2,
+     "you said to repeat something 2 times and then go on, but the plan repeats all of it "
+     "(look up 30°, then turn left 90°)"),
     # An object said only to deny it is not the one meant.
     ("go to the table, not the chair", "approach chair;", "you said not the chair, but the plan uses it"),
     ("grab the red cup, not the blue cup", "grasp blue_cup;", "you said not the blue cup, but the plan uses it"),
@@ -145,6 +152,9 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     ("pick up the keys, not the cup", "grasp keys;"),
     ("grab the cup no the keys", "grasp keys;"),
     ("grab the red cup, not the blue cup", "grasp red_cup;"),
+    ("go forward one meter three times then turn right", "forward 1; forward 1; forward 1; turnright 1.5708;"),
+    ("go forward one meter and turn right, 3 times", "forward 1; turnright 1.5708; " * 3),
+    ("go forward 1 meter and turn right, and do that 3 times", "forward 1; turnright 1.5708; " * 3),
     # A suggestion is a request, not a negation.
     ("why don't you look up", "lookup 0.5236;"),
     ("why not turn left", "turnleft 1.5708;"),
