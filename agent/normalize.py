@@ -32,6 +32,13 @@ _TENS = {"twenty": 20, "thirty": 30, "forty": 40, "fifty": 50, "sixty": 60, "sev
          "eighty": 80, "ninety": 90}
 _DIGIT_WORDS = {**{w: v for w, v in _ONES.items() if v < 10}, "o": 0}
 _FRACTIONS = {"half": 0.5, "quarter": 0.25, "third": 1 / 3}
+# The parts a whole is cut into: "a third", "three quarters", "two fifths".
+_DENOMINATORS = {
+    **dict.fromkeys(("half", "halves"), 2), **dict.fromkeys(("third", "thirds"), 3),
+    **dict.fromkeys(("quarter", "quarters"), 4), **dict.fromkeys(("fifth", "fifths"), 5),
+    **dict.fromkeys(("sixth", "sixths"), 6), **dict.fromkeys(("eighth", "eighths"), 8),
+    **dict.fromkeys(("tenth", "tenths"), 10),
+}
 
 # Words an ASR writes for a number word; only read as numbers when a unit or
 # `times` follows, so "go to the door" and "look for the cup" are untouched.
@@ -51,6 +58,7 @@ _ANGLES = {
     **dict.fromkeys(("rad", "rads", "radian", "radians"), 1.0),
 }
 # Whole turns: "two full turns", "3 circles". A bare "a turn" stays a verb.
+_ONE_REVOLUTION = ("turn", "circle", "rotation", "revolution")
 _REVOLUTIONS = {"turn", "turns", "circle", "circles", "rotation", "rotations", "revolution",
                 "revolutions", "spin", "spins", "lap", "laps"}
 
@@ -274,6 +282,8 @@ def _convert_at(tokens: list[str], i: int) -> tuple[str, int] | None:
         # The verb stays: "make a u-turn" asks the robot to turn.
         return f"turn {format_number(math.pi)} rad", end
     token = tokens[i]
+    if (part := _fraction_of(tokens, i)) is not None:
+        return part
     parsed = _parse_number(tokens, i)
     if parsed is not None:
         value, j = parsed
@@ -297,9 +307,29 @@ def _convert_at(tokens: list[str], i: int) -> tuple[str, int] | None:
         if unit is not None:
             return unit
         # "half a turn", "a quarter turn": fractions of a whole revolution.
-        if token in ("half", "quarter", "a") and value < 1 and j < len(tokens) and tokens[j] in (
-                "turn", "circle", "rotation", "revolution"):
+        if token in ("half", "quarter", "a") and value < 1 and j < len(tokens) and tokens[j] in _ONE_REVOLUTION:
             return f"{format_number(value * 2 * math.pi)} rad", j + 1
+    return None
+
+
+def _fraction_of(tokens: Sequence[str], i: int) -> tuple[str, int] | None:
+    """ "a third of a turn", "three quarters of a meter": the fraction of a unit or of a turn, worked out."""
+    if i < len(tokens) and tokens[i] in ("a", "an"):
+        numerator, j = 1.0, i + 1
+    elif (parsed := _parse_integer_words(tokens, i)) is not None or (
+            i < len(tokens) and tokens[i].isdigit() and (parsed := (float(tokens[i]), i + 1))):
+        numerator, j = parsed
+    else:
+        return None
+    if j >= len(tokens) or tokens[j] not in _DENOMINATORS:
+        return None
+    value, j = numerator / _DENOMINATORS[tokens[j]], j + 1
+    if tokens[j:j + 1] == ["of"] and tokens[j + 1:j + 2] in (["a"], ["an"]):
+        j += 2
+    if (unit := _with_unit(tokens, value, j, explicit=False)) is not None:
+        return unit
+    if j < len(tokens) and tokens[j] in _ONE_REVOLUTION:
+        return f"{format_number(value * 2 * math.pi)} rad", j + 1
     return None
 
 

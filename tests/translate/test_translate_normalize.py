@@ -43,6 +43,12 @@ from agent.normalize import normalize_task
         # Thanks and corrections carry meaning the model needs: a closing is no task, "i mean" corrects.
         ("cheers, thanks, that's all", "cheers, thanks, that's all"),
         ("turn left, i mean right", "turn left, i mean right"),
+        # A fraction of a unit or of a turn is worked out, as "half a meter" is.
+        ("turn left a third of a turn", "turn left 2.0944 rad"),
+        ("move three quarters of a meter", "move 0.75 m"),
+        ("spin two thirds of a turn", "spin 4.1888 rad"),
+        ("go forward one fifth of a meter", "go forward 0.2 m"),
+        ("an eighth of a circle", "0.7854 rad"),
         # A bare number that corrects an amount is in the amount's unit.
         ("turn left 30 degrees, no, 60", "turn left 0.5236 rad, no, 1.0472 rad"),
         ("move 50 centimeters, make that 80", "move 0.5 m, make that 0.8 m"),
@@ -57,7 +63,8 @@ def test_normalize_converts_numbers_units_and_fillers(task: str, expected: str) 
 
 @pytest.mark.parametrize(
     "task",
-    ["look for the cup", "go to the door", "turn a little", "grasp the red cup", "make a turn"],
+    ["look for the cup", "go to the door", "turn a little", "grasp the red cup", "make a turn",
+     "grab a third of the cups"],
 )
 def test_normalize_keeps_words_that_only_sound_like_numbers(task: str) -> None:
     assert normalize_task(task) == task
