@@ -27,16 +27,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from agent.adapter.data import generate
 from agent.adapter.recipe import Recipe
-from agent.adapter.train import (
-    TARGET_MODULES,
-    answer_loss,
-    batches,
-    collate,
-    encode,
-    load_base,
-    native_bf16,
-    require_train_extra,
-)
+from agent.adapter.train import answer_loss, batches, collate, encode, lora_model, require_train_extra
 from agent.translate.model_path import resolve_model
 from rsl.profile import load_profile
 
@@ -56,7 +47,6 @@ def main() -> int:
         parser.error("--steps must be at least 1")
     require_train_extra()
     import torch
-    from peft import LoraConfig, get_peft_model
     from torch.profiler import ProfilerActivity, profile
 
     recipe = Recipe()
@@ -64,14 +54,7 @@ def main() -> int:
     torch.manual_seed(recipe.seed)
     device = "cuda" if torch.cuda.is_available() else "cpu"
     print("loading the base model and generating the recipe's pairs ...", file=sys.stderr, flush=True)
-    tokenizer, model = load_base(resolve_model(None))
-    bf16 = native_bf16(device)
-    if bf16:
-        model = model.to(torch.bfloat16)
-    config = LoraConfig(r=recipe.rank, lora_alpha=int(recipe.alpha), lora_dropout=0.0,
-                        target_modules=list(TARGET_MODULES), bias="none", task_type="CAUSAL_LM")
-    model = get_peft_model(model, config).to(device)
-    model.train()
+    tokenizer, model, bf16 = lora_model(resolve_model(None), recipe, device)
     examples = encode(tokenizer, generate(load_profile(), recipe.pairs, seed=recipe.seed))
     plan = batches(examples, recipe.batch, WARMUP + args.steps + 1, random.Random(recipe.seed))
     trainable = [p for p in model.parameters() if p.requires_grad]

@@ -142,7 +142,6 @@ def train(pairs: Sequence[Pair], base_gguf: Path, out: Path, recipe: Recipe, *,
     """Train a LoRA adapter on `pairs` and write it to `out` as a llama.cpp LoRA GGUF."""
     require_train_extra()
     import torch
-    from peft import LoraConfig, get_peft_model
 
     random.seed(recipe.seed)
     torch.manual_seed(recipe.seed)
@@ -151,15 +150,8 @@ def train(pairs: Sequence[Pair], base_gguf: Path, out: Path, recipe: Recipe, *,
     device = "cuda" if torch.cuda.is_available() else "cpu"
 
     progress(f"loading base model {base_gguf.name} ...")
-    tokenizer, model = load_base(base_gguf)
-    bf16 = native_bf16(device) if recipe.bf16 is None else recipe.bf16
+    tokenizer, model, bf16 = lora_model(base_gguf, recipe, device)
     progress(f"the frozen base runs in {'bfloat16' if bf16 else 'float32'} on {device}")
-    if bf16:
-        model = model.to(torch.bfloat16)
-    config = LoraConfig(r=recipe.rank, lora_alpha=int(recipe.alpha), lora_dropout=0.0,
-                        target_modules=list(TARGET_MODULES), bias="none", task_type="CAUSAL_LM")
-    model = get_peft_model(model, config).to(device)
-    model.train()
     examples = encode(tokenizer, pairs)
     if not examples:
         raise TrainingError("no training pair fits in the token budget; generate more or shorter pairs")
@@ -196,6 +188,22 @@ def train(pairs: Sequence[Pair], base_gguf: Path, out: Path, recipe: Recipe, *,
     return TrainResult(adapter=out, steps=len(plan), examples=len(examples), seconds=seconds, device=device,
                        first_loss=sum(head) / len(head), final_loss=sum(tail) / len(tail),
                        losses=tuple(losses), bf16=bf16)
+
+
+def lora_model(base_gguf: Path, recipe: Recipe, device: str) -> tuple[Any, Any, bool]:
+    """(tokenizer, the base with `recipe`'s LoRA weights in training mode, whether the base runs in bfloat16)."""
+    import torch
+    from peft import LoraConfig, get_peft_model
+
+    tokenizer, model = load_base(base_gguf)
+    bf16 = native_bf16(device) if recipe.bf16 is None else recipe.bf16
+    if bf16:
+        model = model.to(torch.bfloat16)
+    config = LoraConfig(r=recipe.rank, lora_alpha=int(recipe.alpha), lora_dropout=0.0,
+                        target_modules=list(TARGET_MODULES), bias="none", task_type="CAUSAL_LM")
+    model = get_peft_model(model, config).to(device)
+    model.train()
+    return tokenizer, model, bf16
 
 
 def schedule(recipe: Recipe) -> Callable[[int], float]:
