@@ -1,8 +1,10 @@
 """How a speaker takes back what they just said ("1 meter, no, 2 meters").
 
-One list for the two places that read it: the training data writes
-self-corrections with these templates, and the meaning checks take back a
-number or an object said right before one of their markers.
+One list for the places that read it: the training data writes
+self-corrections with these templates, the meaning checks take back a
+number or an object said right before one of their markers, and the
+normalizer gives a bare number after a marker the unit of the amount it
+corrects.
 """
 
 from __future__ import annotations

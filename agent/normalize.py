@@ -57,8 +57,9 @@ _ANGLES = {
     **dict.fromkeys(("degree", "degrees", "deg", "degs", "°"), math.pi / 180),
     **dict.fromkeys(("rad", "rads", "radian", "radians"), 1.0),
 }
-# Whole turns: "two full turns", "3 circles". A bare "a turn" stays a verb.
+# What a fraction of a turn is a fraction of: "a third of a turn", "half a circle".
 _ONE_REVOLUTION = ("turn", "circle", "rotation", "revolution")
+# Whole turns: "two full turns", "3 circles". A bare "a turn" stays a verb.
 _REVOLUTIONS = {"turn", "turns", "circle", "circles", "rotation", "rotations", "revolution",
                 "revolutions", "spin", "spins", "lap", "laps"}
 
@@ -314,13 +315,16 @@ def _convert_at(tokens: list[str], i: int) -> tuple[str, int] | None:
 
 def _fraction_of(tokens: Sequence[str], i: int) -> tuple[str, int] | None:
     """ "a third of a turn", "three quarters of a meter": the fraction of a unit or of a turn, worked out."""
-    if i < len(tokens) and tokens[i] in ("a", "an"):
-        numerator, j = 1.0, i + 1
-    elif (parsed := _parse_integer_words(tokens, i)) is not None or (
-            i < len(tokens) and tokens[i].isdigit() and (parsed := (float(tokens[i]), i + 1))):
-        numerator, j = parsed
+    parsed: tuple[float, int] | None
+    if tokens[i:i + 1] in (["a"], ["an"]):
+        parsed = 1.0, i + 1
+    elif tokens[i:i + 1] and tokens[i].isdigit():
+        parsed = float(tokens[i]), i + 1
     else:
+        parsed = _parse_integer_words(tokens, i)
+    if parsed is None:
         return None
+    numerator, j = parsed
     if j >= len(tokens) or tokens[j] not in _DENOMINATORS:
         return None
     value, j = numerator / _DENOMINATORS[tokens[j]], j + 1

@@ -462,23 +462,22 @@ def _vague_amount(named: list[_Convention], vocab: _Vocabulary, unit: str) -> fl
 _CORRECTING = frozenset(m.split()[0] for m in MARKERS)
 
 
-def _spliced_out(text: str, spans: Iterable[re.Match[str]]) -> str:
-    """`text` with the matched spans blanked."""
-    out = text
-    for m in sorted(spans, key=lambda m: m.start(), reverse=True):
-        out = out[:m.start()] + " " + out[m.end():]
-    return out
-
-
 def _objects(text: str, plan: Plan, known: Collection[str] | None, vocab: _Vocabulary) -> list[Doubt]:
     """Every object in the plan was said, and every known object said is in the plan."""
     known_words = {w for name in known or () for w in name.lower().split("_")}
     taken_back = {m.group(1) for m in _TAKEN_BACK_WORD.finditer(text) if m.group(2) in known_words}
     words = set(_WORD.findall(text))
     # "not the chair" denies an object; "no, the keys" corrects to one.
-    denials = [m for m in _NEGATION.finditer(text) if _WORD.findall(m.group(0))[0] not in _CORRECTING]
-    denied = {w for m in denials for w in _WORD.findall(m.group(0))}
-    affirmed = set(_WORD.findall(_spliced_out(text, denials)))
+    denied: set[str] = set()
+
+    def deny(m: re.Match[str]) -> str:
+        said = _WORD.findall(m.group(0))
+        if said[0] in _CORRECTING:
+            return m.group(0)
+        denied.update(said)
+        return " "
+
+    affirmed = set(_WORD.findall(_NEGATION.sub(deny, text)))
     planned = {a.name for c in plan for a in c.args if isinstance(a, ObjectRef)}
     doubts = []
     for name in sorted(planned):
