@@ -41,6 +41,12 @@ _CORRECTED = rf",?\s+(?:{'|'.join(MARKERS)}),?\s+(?:the |a |an )?"
 _TAKEN_BACK_NUMBER = re.compile(rf"(?<![\w.])(-?\d*\.?\d+)(?: (?:m|rad)\b)?{_CORRECTED}(?=-?\d*\.?\d)")
 _TAKEN_BACK_WORD = re.compile(rf"\b([a-z]+){_CORRECTED}([a-z]+)")
 _FIRST_CLAUSE = re.compile(r"[.;]")
+# Words that come before a thing's name and are never one ("approach a" from "move to the right a bit").
+DETERMINERS = ("the", "a", "an", "some", "that", "this", "my", "your")
+# Two amounts in one unit with only a comma and a few words between: the second may correct the first
+# in words no marker lists ("90 degrees, correction, 45 degrees").
+_RESTATED = re.compile(r"(?<![\w.])(\d*\.?\d+) (m|rad),((?: [a-z']+){0,3}?),? (\d*\.?\d+) \2\b")
+_SEQUENCE_WORDS = frozenset({"and", "then", "after", "next", "finally", "again", "another", "more", "times"})
 # What negates what follows it up to the end of its clause ("don't move, just look left"), and a part
 # kept still ("keep your head still and turn left"). "why don't you look up" suggests, not negates.
 _NEGATION = re.compile(r"(?<!\bwhy )\b(?:don'?t|do not|never|without|no|not)\b[^,.;]*"
@@ -101,6 +107,7 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     doubts += _numbers(text, plan, vocab, profile)
     doubts += _totals(text, plan, vocab, named)
     doubts += _repeated_after(text, plan, profile)
+    doubts += _restated(text, plan, vocab, profile)
     doubts += _carried_out(_named(_WORD.findall(affirmed), vocab), text, plan, vocab)
     doubts += _objects(text, plan, known_objects, vocab)
     return tuple({d.reason: d for d in doubts}.values())
@@ -383,6 +390,33 @@ def _repeated_after(text: str, plan: Plan, profile: Profile) -> list[Doubt]:
                                 f"repeats all of it ({block})")]
 
 
+def _restated(text: str, plan: Plan, vocab: _Vocabulary, profile: Profile) -> list[Doubt]:
+    """Two amounts said one after the other, both done by back-to-back steps of one skill.
+
+    "turn right 90 degrees, correction, 45 degrees" most likely takes the
+    first amount back; a word between that names a step, a part or a
+    sequence ("then", "another") makes them two steps.
+    """
+    doubts = []
+    steps = list(plan)
+    for m in _RESTATED.finditer(text):
+        between = set(_WORD.findall(m.group(3)))
+        if between & (vocab.skill_words | vocab.part_nouns | _SEQUENCE_WORDS):
+            continue
+        first, second, unit = float(m.group(1)), float(m.group(4)), m.group(2)
+        for a, b in itertools.pairwise(steps):
+            amounts = [(x, y) for x, y in zip(a.args, b.args, strict=False)
+                       if isinstance(x, Quantity) and isinstance(y, Quantity) and x.unit == y.unit == unit]
+            if a.skill == b.skill and any(_close(abs(x.value), first) and _close(abs(y.value), second)
+                                          for x, y in amounts):
+                doubts.append(Doubt("restated", f"you said {quantity(Quantity(first, unit))} and then "
+                                                f"{quantity(Quantity(second, unit))}; if the second corrects the "
+                                                f"first, the plan should not do both ({say(a, profile)}, then "
+                                                f"{say(b, profile)})"))
+                break
+    return doubts
+
+
 # How many words may stand between a phrase's own ("turn all the way around" names "turn around").
 _PHRASE_GAP = 3
 
@@ -485,6 +519,9 @@ def _objects(text: str, plan: Plan, known: Collection[str] | None, vocab: _Vocab
         if name.lower() in vocab.skill_words:
             doubts.append(Doubt("object", f"the plan takes '{name}' for an object, but it names a direction "
                                           "or an action"))
+        elif name.lower() in DETERMINERS:
+            doubts.append(Doubt("object", f"the plan takes '{name}' for an object, but it is a word that comes "
+                                          "before a thing's name"))
         elif not (name_words & words):
             doubts.append(Doubt("object", f"the plan uses the {name.replace('_', ' ')}, which you did not mention"))
         elif not name_words <= affirmed and name_words <= denied:

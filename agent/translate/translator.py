@@ -25,6 +25,7 @@ from agent.translate.automaton import RslAutomaton
 from agent.translate.clauses import Clause, split_clauses
 from agent.translate.confidence import Assessment, assess, model_signal, result_fields
 from agent.translate.engine import CancelFlag, Fork, Generation
+from agent.translate.meaning import DETERMINERS
 from agent.translate.model_path import ModelNotFoundError
 from agent.translate.prompt import (
     Shot,
@@ -51,7 +52,7 @@ CLAUSE_STATEMENTS = 8
 DEFAULT_SHOTS = 0
 _NUMBER = re.compile(r"-?\d*\.?\d+")
 _NUMBER_UNIT = re.compile(r"(-?\d*\.?\d+)(?: (m|rad)\b)?")
-_OBJECT_PHRASE = re.compile(r"\b(?:the|a|an|some|that|this|my|your) ((?:[a-z]+ )?[a-z]+)\b")
+_OBJECT_PHRASE = re.compile(rf"\b(?:{'|'.join(DETERMINERS)}) ((?:[a-z]+ )?[a-z]+)\b")
 _PHRASE_END = frozenset({"with", "and", "for", "to", "from", "on", "in", "of", "at", "by", "then", "it", "up",
                          "down", "again", "into", "onto", "over", "under", "near", "there", "here", "times"})
 _NOT_OBJECTS = frozenset({"left", "right", "start", "origin", "beginning", "way", "same", "other", "front",

@@ -106,6 +106,13 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
     ("go to the table, not the chair", "approach chair;", "you said not the chair, but the plan uses it"),
     ("grab the red cup, not the blue cup", "grasp blue_cup;", "you said not the blue cup, but the plan uses it"),
     ("don't drive 2 meters", "forward 2;", "you said not to move the base, but the plan does (drive forward 2 m)"),
+    # A second amount right after the first, in words no correction marker lists, may take it back.
+    ("turn right ninety degrees, correction, forty five degrees", "turnright 1.5708; turnright 0.7854;",
+     "you said 90° and then 45°; if the second corrects the first, the plan should not do both "
+     "(turn right 90°, then turn right 45°)"),
+    # An article is never a thing's name.
+    ("move over to the right a bit", "approach a;",
+     "the plan takes 'a' for an object, but it is a word that comes before a thing's name"),
 ])
 def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str, expected: str,
                                                          profile: Profile) -> None:
@@ -158,6 +165,9 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     # A suggestion is a request, not a negation.
     ("why don't you look up", "lookup 0.5236;"),
     ("why not turn left", "turnleft 1.5708;"),
+    # A word between two amounts that asks for another step makes them two steps.
+    ("turn left 90 degrees, then 45 degrees", "turnleft 1.5708; turnleft 0.7854;"),
+    ("turn left 90 degrees, and another 45 degrees", "turnleft 1.5708; turnleft 0.7854;"),
 ])
 def test_a_plan_that_does_what_was_said_has_no_doubt(task: str, program: str, profile: Profile) -> None:
     assert reasons(task, program, profile, ["cup", "table", "keys"]) == []
