@@ -47,6 +47,8 @@ DETERMINERS = ("the", "a", "an", "some", "that", "this", "my", "your")
 # in words no marker lists ("90 degrees, correction, 45 degrees").
 _RESTATED = re.compile(r"(?<![\w.])(\d*\.?\d+) (m|rad),((?: [a-z']+){0,3}?),? (\d*\.?\d+) \2\b")
 _SEQUENCE_WORDS = frozenset({"and", "then", "after", "next", "finally", "again", "another", "more", "times"})
+# Words that ask for a step once more without a count.
+_AGAIN = re.compile(r"\b(?:again|another|more|repeat\w*|twice)\b")
 # What negates what follows it up to the end of its clause ("don't move, just look left"), and a part
 # kept still ("keep your head still and turn left"). "why don't you look up" suggests, not negates.
 _NEGATION = re.compile(r"(?<!\bwhy )\b(?:don'?t|do not|never|without|no|not)\b[^,.;]*"
@@ -103,11 +105,12 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     named = _named(_WORD.findall(text), vocab)
     doubts: list[Doubt] = []
     doubts += _parts(plan, vocab, words, set(_WORD.findall(negated)), named, profile)
-    doubts += _directions(plan, vocab, words, profile)
+    doubts += _directions(plan, vocab, words, named, profile)
     doubts += _numbers(text, plan, vocab, profile)
     doubts += _totals(text, plan, vocab, named)
     doubts += _repeated_after(text, plan, profile)
     doubts += _restated(text, plan, vocab, profile)
+    doubts += _doubled(text, plan, profile)
     doubts += _carried_out(_named(_WORD.findall(affirmed), vocab), text, plan, vocab)
     doubts += _objects(text, plan, known_objects, vocab)
     return tuple({d.reason: d for d in doubts}.values())
@@ -283,7 +286,15 @@ def _parts(plan: Plan, vocab: _Vocabulary, words: set[str], negated: set[str], n
     return doubts
 
 
-def _directions(plan: Plan, vocab: _Vocabulary, words: set[str], profile: Profile) -> list[Doubt]:
+def _directions(plan: Plan, vocab: _Vocabulary, words: set[str], named: list[_Convention],
+                profile: Profile) -> list[Doubt]:
+    """The plan goes the way that was said, and goes both ways only when both were said.
+
+    A convention the task names may go both ways ("look around" pans left,
+    then right).
+    """
+    allowed = {skill for c in named for skill in c.skills}
+    direction_words = {w for d in vocab.directions for w in (*d[1], *d[3])}
     doubts = []
     for skill, mine, opposite, theirs in vocab.directions:
         for said_words, unsaid_words, wrong in ((mine, theirs, opposite), (theirs, mine, skill)):
@@ -292,6 +303,15 @@ def _directions(plan: Plan, vocab: _Vocabulary, words: set[str], profile: Profil
                 if hit is not None:
                     doubts.append(Doubt("direction", f"you said {min(said_words)}, but the plan goes the "
                                                      f"other way ({say(hit, profile)})"))
+        # "pan left then right" says the head's ways in the words the base's turns are told apart by.
+        ways = [said_words | ({raw} & direction_words)
+                for said_words, raw in zip((mine, theirs), _difference(skill, opposite), strict=True)]
+        both = [c for c in plan if c.skill in (skill, opposite) and c.skill not in allowed]
+        if {c.skill for c in both} == {skill, opposite} and not all(_said(words, way) for way in ways):
+            back = next(c for c in both if c.skill != both[0].skill)
+            doubts.append(Doubt("direction", f"the plan goes both ways ({say(both[0], profile)}, then "
+                                             f"{say(back, profile)}), but you did not say both "
+                                             f"{min(ways[0], key=len)} and {min(ways[1], key=len)}"))
     return doubts
 
 
@@ -415,6 +435,22 @@ def _restated(text: str, plan: Plan, vocab: _Vocabulary, profile: Profile) -> li
                                                 f"{say(b, profile)})"))
                 break
     return doubts
+
+
+def _doubled(text: str, plan: Plan, profile: Profile) -> list[Doubt]:
+    """The same step twice in a row is asked for: by a count, a word of doing again, or its amount said twice."""
+    if _counts(text) > 1 or _AGAIN.search(text):
+        return []
+    said = _said_numbers(text)
+    for a, b in itertools.pairwise(plan):
+        if a.skill != b.skill or a.args != b.args:
+            continue
+        amounts = [abs(x.value) for x in a.args if isinstance(x, Quantity)]
+        if any(sum(1 for value, _unit in said if _close(value, amount)) >= 2 for amount in amounts):
+            continue
+        return [Doubt("doubled", f"the plan does the same step twice in a row ({say(a, profile)}), but you "
+                                 "did not ask for it twice")]
+    return []
 
 
 # How many words may stand between a phrase's own ("turn all the way around" names "turn around").

@@ -110,6 +110,12 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
     ("turn right ninety degrees, correction, forty five degrees", "turnright 1.5708; turnright 0.7854;",
      "you said 90° and then 45°; if the second corrects the first, the plan should not do both "
      "(turn right 90°, then turn right 45°)"),
+    # The same step twice in a row, asked for once.
+    ("I dropped my pen, can you pick the pen up", "grasp pen; grasp pen;",
+     "the plan does the same step twice in a row (pick up the pen), but you did not ask for it twice"),
+    # Both ways, when neither or only one was said.
+    ("turn round and face me", "turnright 1.5708; turnleft 1.5708;",
+     "the plan goes both ways (turn right 90°, then turn left 90°), but you did not say both left and right"),
     # An article is never a thing's name.
     ("move over to the right a bit", "approach a;",
      "the plan takes 'a' for an object, but it is a word that comes before a thing's name"),
@@ -165,6 +171,11 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     # A suggestion is a request, not a negation.
     ("why don't you look up", "lookup 0.5236;"),
     ("why not turn left", "turnleft 1.5708;"),
+    ("turn left 90 degrees, turn left 90 degrees", "turnleft 1.5708; turnleft 1.5708;"),
+    ("look up, and look up again", "lookup 0.5236; lookup 0.5236;"),
+    ("look left and then right", "lookleft 0.5236; lookright 0.5236;"),
+    ("pan left then pan right", "lookleft 0.5236; lookright 0.5236;"),
+    ("drive forward 2 meters, then back 2 meters", "forward 2; backward 2;"),
     # A word between two amounts that asks for another step makes them two steps.
     ("turn left 90 degrees, then 45 degrees", "turnleft 1.5708; turnleft 0.7854;"),
     ("turn left 90 degrees, and another 45 degrees", "turnleft 1.5708; turnleft 0.7854;"),
