@@ -375,7 +375,8 @@ def _totals(text: str, plan: Plan, vocab: _Vocabulary, named: list[_Convention])
         planned = sum(abs(a.value) for c in moves for a in c.args if isinstance(a, Quantity) and a.unit == unit)
         if planned == 0:
             continue
-        said_total = sum(v for v, u in said if u == unit)
+        # A bare number ("go forward two") may be an amount in either unit.
+        said_total = sum(v for v, u in said if u in (unit, ""))
         counted = said_total > 0 and _COUNT.search(text) is not None
         if said_total == 0:
             said_total = _vague_amount(named, vocab, unit)
