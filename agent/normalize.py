@@ -63,6 +63,11 @@ _ONE_REVOLUTION = ("turn", "circle", "rotation", "revolution")
 _REVOLUTIONS = {"turn", "turns", "circle", "circles", "rotation", "rotations", "revolution",
                 "revolutions", "spin", "spins", "lap", "laps"}
 
+# The ways a turn goes. A bare number after one that is too large to be radians of a turn
+# ("turn left 90") can only be degrees: left as it is, the model copies it into a 90 rad turn.
+_TURN_WAYS = frozenset({"left", "right", "clockwise", "counterclockwise", "anticlockwise", "around"})
+_LARGEST_BARE_DEGREES = 360
+
 _FILLERS: tuple[tuple[str, ...], ...] = tuple(
     tuple(p.split())
     for p in sorted(
@@ -290,6 +295,8 @@ def _convert_at(tokens: list[str], i: int) -> tuple[str, int] | None:
         value, j = parsed
         if (unit := _with_unit(tokens, value, j, explicit=True)) is not None:
             return unit
+        if _bare_degrees(tokens, i, value, j):
+            return f"{format_number(math.radians(value))} rad", j
         return format_number(value), j
     if token in _HOMOPHONES:
         nxt = tokens[i + 1] if i + 1 < len(tokens) else ""
@@ -311,6 +318,15 @@ def _convert_at(tokens: list[str], i: int) -> tuple[str, int] | None:
         if token in ("half", "quarter", "a") and value < 1 and j < len(tokens) and tokens[j] in _ONE_REVOLUTION:
             return f"{format_number(value * 2 * math.pi)} rad", j + 1
     return None
+
+
+def _bare_degrees(tokens: Sequence[str], i: int, value: float, end: int) -> bool:
+    """Whether the bare number tokens[i:end] follows a turn's way and is too large to be radians."""
+    before = tokens[i - 2] if tokens[i - 1:i] == ["by"] and i >= 2 else tokens[i - 1] if i >= 1 else ""
+    after = tokens[end:end + 2]
+    coordinate = after[:1] == [","] and len(after) == 2 and _is_number_token(after[1])
+    return (before in _TURN_WAYS and value == int(value) and 2 * math.pi < value <= _LARGEST_BARE_DEGREES
+            and after[:1] != ["times"] and not coordinate)
 
 
 def _fraction_of(tokens: Sequence[str], i: int) -> tuple[str, int] | None:

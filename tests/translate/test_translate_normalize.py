@@ -55,6 +55,10 @@ from agent.normalize import normalize_task
         ("go forward three meters, no wait, four", "go forward 3 m, no wait, 4 m"),
         ("turn left 90 degrees, no, 2 times", "turn left 1.5708 rad, no, 2 times"),
         ("drive 2 meters, no, 3 feet", "drive 2 m, no, 0.9144 m"),
+        # A bare number after a turn's way, too large to be radians, is degrees.
+        ("turn left 90", "turn left 1.5708 rad"),
+        ("rotate clockwise by forty five", "rotate clockwise by 0.7854 rad"),
+        ("go forward 2 then turn right 180", "go forward 2 then turn right 3.1416 rad"),
     ],
 )
 def test_normalize_converts_numbers_units_and_fillers(task: str, expected: str) -> None:
@@ -64,7 +68,7 @@ def test_normalize_converts_numbers_units_and_fillers(task: str, expected: str) 
 @pytest.mark.parametrize(
     "task",
     ["look for the cup", "go to the door", "turn a little", "grasp the red cup", "make a turn",
-     "grab a third of the cups"],
+     "grab a third of the cups", "turn left 3", "turn left 10 times", "turn right 400", "go left 10, 5"],
 )
 def test_normalize_keeps_words_that_only_sound_like_numbers(task: str) -> None:
     assert normalize_task(task) == task
