@@ -322,7 +322,8 @@ def _convert_at(tokens: list[str], i: int) -> tuple[str, int] | None:
 
 def _bare_degrees(tokens: Sequence[str], i: int, value: float, end: int) -> bool:
     """Whether the bare number tokens[i:end] follows a turn's way and is too large to be radians."""
-    before = tokens[i - 2] if tokens[i - 1:i] == ["by"] and i >= 2 else tokens[i - 1] if i >= 1 else ""
+    at = i - 2 if tokens[i - 1:i] == ["by"] else i - 1
+    before = tokens[at] if at >= 0 else ""
     after = tokens[end:end + 2]
     coordinate = after[:1] == [","] and len(after) == 2 and _is_number_token(after[1])
     return (before in _TURN_WAYS and value == int(value) and 2 * math.pi < value <= _LARGEST_BARE_DEGREES

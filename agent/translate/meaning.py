@@ -46,9 +46,10 @@ DETERMINERS = ("the", "a", "an", "some", "that", "this", "my", "your")
 # Two amounts in one unit with only a comma and a few words between: the second may correct the first
 # in words no marker lists ("90 degrees, correction, 45 degrees").
 _RESTATED = re.compile(r"(?<![\w.])(\d*\.?\d+) (m|rad),((?: [a-z']+){0,3}?),? (\d*\.?\d+) \2\b")
-_SEQUENCE_WORDS = frozenset({"and", "then", "after", "next", "finally", "again", "another", "more", "times"})
 # Words that ask for a step once more without a count.
-_AGAIN = re.compile(r"\b(?:again|another|more|repeat\w*|twice)\b")
+_AGAIN_WORDS = ("again", "another", "more")
+_AGAIN = re.compile(rf"\b(?:{'|'.join(_AGAIN_WORDS)}|repeat\w*|twice)\b")
+_SEQUENCE_WORDS = frozenset({"and", "then", "after", "next", "finally", "times", *_AGAIN_WORDS})
 # What negates what follows it up to the end of its clause ("don't move, just look left"), and a part
 # kept still ("keep your head still and turn left"). "why don't you look up" suggests, not negates.
 _NEGATION = re.compile(r"(?<!\bwhy )\b(?:don'?t|do not|never|without|no|not)\b[^,.;]*"
@@ -77,6 +78,7 @@ class _Vocabulary:
     skill_words: frozenset[str]  # keywords, aliases and direction words: never an object's name
     part_nouns: frozenset[str]  # the nouns of the robot's description ("head", "camera")
     opposites: dict[str, str]  # skill keyword -> its opposite, both ways
+    direction_words: frozenset[str]  # the words of `directions`, every pair's
 
 
 @dataclass(frozen=True)
@@ -228,7 +230,8 @@ def _build_vocabulary(profile: Profile) -> _Vocabulary:
                        conventions=tuple(conventions), coordinates=coordinates,
                        skill_words=frozenset({w for ws in words.values() for w in ws} - set(nouns)
                                              | direction_words),
-                       part_nouns=frozenset(nouns), opposites=opposites)
+                       part_nouns=frozenset(nouns), opposites=opposites,
+                       direction_words=frozenset(direction_words))
 
 
 _VOCABULARIES: dict[tuple[str, str], _Vocabulary] = {}
@@ -294,7 +297,6 @@ def _directions(plan: Plan, vocab: _Vocabulary, words: set[str], named: list[_Co
     then right).
     """
     allowed = {skill for c in named for skill in c.skills}
-    direction_words = {w for d in vocab.directions for w in (*d[1], *d[3])}
     doubts = []
     for skill, mine, opposite, theirs in vocab.directions:
         for said_words, unsaid_words, wrong in ((mine, theirs, opposite), (theirs, mine, skill)):
@@ -304,7 +306,7 @@ def _directions(plan: Plan, vocab: _Vocabulary, words: set[str], named: list[_Co
                     doubts.append(Doubt("direction", f"you said {min(said_words)}, but the plan goes the "
                                                      f"other way ({say(hit, profile)})"))
         # "pan left then right" says the head's ways in the words the base's turns are told apart by.
-        ways = [said_words | ({raw} & direction_words)
+        ways = [said_words | ({raw} & vocab.direction_words)
                 for said_words, raw in zip((mine, theirs), _difference(skill, opposite), strict=True)]
         both = [c for c in plan if c.skill in (skill, opposite) and c.skill not in allowed]
         if {c.skill for c in both} == {skill, opposite} and not all(_said(words, way) for way in ways):
@@ -419,13 +421,12 @@ def _restated(text: str, plan: Plan, vocab: _Vocabulary, profile: Profile) -> li
     sequence ("then", "another") makes them two steps.
     """
     doubts = []
-    steps = list(plan)
     for m in _RESTATED.finditer(text):
         between = set(_WORD.findall(m.group(3)))
         if between & (vocab.skill_words | vocab.part_nouns | _SEQUENCE_WORDS):
             continue
         first, second, unit = float(m.group(1)), float(m.group(4)), m.group(2)
-        for a, b in itertools.pairwise(steps):
+        for a, b in itertools.pairwise(plan):
             amounts = [(x, y) for x, y in zip(a.args, b.args, strict=False)
                        if isinstance(x, Quantity) and isinstance(y, Quantity) and x.unit == y.unit == unit]
             if a.skill == b.skill and any(_close(abs(x.value), first) and _close(abs(y.value), second)

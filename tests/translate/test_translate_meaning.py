@@ -171,13 +171,15 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     # A suggestion is a request, not a negation.
     ("why don't you look up", "lookup 0.5236;"),
     ("why not turn left", "turnleft 1.5708;"),
+    # The same step twice in a row, asked for twice.
     ("turn left 90 degrees, turn left 90 degrees", "turnleft 1.5708; turnleft 1.5708;"),
     ("look up, and look up again", "lookup 0.5236; lookup 0.5236;"),
+    # Both ways, when both were said.
     ("look left and then right", "lookleft 0.5236; lookright 0.5236;"),
     ("pan left then pan right", "lookleft 0.5236; lookright 0.5236;"),
+    ("drive forward 2 meters, then back 2 meters", "forward 2; backward 2;"),
     # A number said without its unit counts toward what was said in all.
     ("back up a meter and then go forward two", "backward 1; forward 2;"),
-    ("drive forward 2 meters, then back 2 meters", "forward 2; backward 2;"),
     # A word between two amounts that asks for another step makes them two steps.
     ("turn left 90 degrees, then 45 degrees", "turnleft 1.5708; turnleft 0.7854;"),
     ("turn left 90 degrees, and another 45 degrees", "turnleft 1.5708; turnleft 0.7854;"),
