@@ -26,6 +26,7 @@ from dataclasses import dataclass
 from agent.corrections import MARKERS
 from agent.translate.clauses import _SHAPES
 from agent.translate.explain import quantity, say
+from agent.translate.names import DETERMINERS
 from rsl.compiler import compile_program
 from rsl.plan import ObjectRef, Plan, Quantity
 from rsl.profile import Profile
@@ -41,8 +42,6 @@ _CORRECTED = rf",?\s+(?:{'|'.join(MARKERS)}),?\s+(?:the |a |an )?"
 _TAKEN_BACK_NUMBER = re.compile(rf"(?<![\w.])(-?\d*\.?\d+)(?: (?:m|rad)\b)?{_CORRECTED}(?=-?\d*\.?\d)")
 _TAKEN_BACK_WORD = re.compile(rf"\b([a-z]+){_CORRECTED}([a-z]+)")
 _FIRST_CLAUSE = re.compile(r"[.;]")
-# Words that come before a thing's name and are never one ("approach a" from "move to the right a bit").
-DETERMINERS = ("the", "a", "an", "some", "that", "this", "my", "your")
 # Two amounts in one unit with only a comma and a few words between: the second may correct the first
 # in words no marker lists ("90 degrees, correction, 45 degrees").
 _RESTATED = re.compile(r"(?<![\w.])(\d*\.?\d+) (m|rad),((?: [a-z']+){0,3}?),? (\d*\.?\d+) \2\b")
@@ -130,6 +129,11 @@ def _words(text: str, vocab: _Vocabulary) -> set[str]:
     said = Counter(tokens)
     return ({t for t in said if verbs[t] < said[t]} | ({WHOLE} if verbs else set())
             | {a + b for a, b in itertools.pairwise(tokens) if a + b in vocab.skill_words})
+
+
+def skill_words(profile: Profile) -> frozenset[str]:
+    """The words of the robot's skills (keywords, aliases, directions): never a thing's name."""
+    return _vocabulary(profile).skill_words
 
 
 def skill_parts(profile: Profile) -> dict[str, str]:

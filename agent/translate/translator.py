@@ -25,8 +25,9 @@ from agent.translate.automaton import RslAutomaton
 from agent.translate.clauses import Clause, split_clauses
 from agent.translate.confidence import Assessment, assess, model_signal, result_fields
 from agent.translate.engine import CancelFlag, Fork, Generation
-from agent.translate.meaning import DETERMINERS
+from agent.translate.meaning import skill_words
 from agent.translate.model_path import ModelNotFoundError
+from agent.translate.names import DETERMINERS, NOT_NAMES, said_only_in_pairs
 from agent.translate.prompt import (
     Shot,
     chat_prompt,
@@ -55,11 +56,6 @@ _NUMBER_UNIT = re.compile(r"(-?\d*\.?\d+)(?: (m|rad)\b)?")
 _OBJECT_PHRASE = re.compile(rf"\b(?:{'|'.join(DETERMINERS)}) ((?:[a-z]+ )?[a-z]+)\b")
 _PHRASE_END = frozenset({"with", "and", "for", "to", "from", "on", "in", "of", "at", "by", "then", "it", "up",
                          "down", "again", "into", "onto", "over", "under", "near", "there", "here", "times"})
-_NOT_OBJECTS = frozenset({"left", "right", "start", "origin", "beginning", "way", "same", "other", "front",
-                          "back", "end", "middle", "centre", "center", "robot", "side", "distance", "time",
-                          "little", "bit", "square", "triangle", "circle", "full", "long", "few", "couple",
-                          "point", "position", "spot", "area", "room", "around", "head", "camera"})
-
 
 # The least probability the model must have given to ending a program early for that ending to be
 # tried when the whole program fails a meaning check (see Translator._shorter_ending).
@@ -472,17 +468,21 @@ class Translator:
         if not self.options.narrow:
             return None
         if not self.options.split_clauses:
-            # A whole task: any word or pair of words it says may name an object; the model, not
-            # an adjective rule, decides which ("pick up the book gently" is `book`).
-            words = [w for w in re.findall(r"[a-z]+", text) if w not in _NOT_OBJECTS]
+            # A whole task: any word or pair of words it says may name an object, and the model decides
+            # which ("pick up the book gently" is `book`). A pair that is plainly one name ("the red
+            # cup") is offered only whole: a model trained on one-word names would keep one word of it
+            # and lose which thing was meant.
+            in_pairs = said_only_in_pairs(text, skill_words(self.profile))
+            words = [w for w in re.findall(r"[a-z]+", text) if w not in NOT_NAMES]
             pairs = [f"{a}_{b}" for a, b in itertools.pairwise(words)]
+            words = [w for w in words if w not in in_pairs]
             return tuple(dict.fromkeys(w for w in (*words, *pairs) if IDENTIFIER.match(w))) or None
         names: list[str] = []
         for phrase in _OBJECT_PHRASE.findall(text):
             words = phrase.split()
             if len(words) == 2 and words[1] in _PHRASE_END:
                 words = words[:1]
-            words = [w for w in words if w not in _NOT_OBJECTS and w not in _PHRASE_END]
+            words = [w for w in words if w not in NOT_NAMES and w not in _PHRASE_END]
             if not words:
                 continue
             names.append(words[-1])

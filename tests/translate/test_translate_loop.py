@@ -136,6 +136,9 @@ def test_the_shipped_adapter_is_the_default_and_stays_verified(profile: Profile)
         assert adapted.model_name.endswith("+" + DEFAULT_ADAPTER.name)
         result = adapted.translate("pick up the cup", known_objects=["cup"])
         assert result.verified and result.program == "grasp cup;\n"
+        # A thing named in two words is named whole, not by the one word a model trained on one-word
+        # names would keep.
+        assert adapted.translate("pick up the water bottle please").program == "grasp water_bottle;\n"
         # The convention's program comes from the profile through the prompt's note.
         result = adapted.translate("look around")
         assert result.verified

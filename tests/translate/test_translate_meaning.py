@@ -183,6 +183,10 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     # A word between two amounts that asks for another step makes them two steps.
     ("turn left 90 degrees, then 45 degrees", "turnleft 1.5708; turnleft 0.7854;"),
     ("turn left 90 degrees, and another 45 degrees", "turnleft 1.5708; turnleft 0.7854;"),
+    # A thing named in two words, kept whole; a word after a name that is not part of it.
+    ("pick up the water bottle please", "grasp water_bottle;"),
+    ("pick up the book gently", "grasp book;"),
+    ("go to the red cup, then pick up the cup", "approach red_cup; grasp cup;"),
 ])
 def test_a_plan_that_does_what_was_said_has_no_doubt(task: str, program: str, profile: Profile) -> None:
     assert reasons(task, program, profile, ["cup", "table", "keys"]) == []

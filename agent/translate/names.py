@@ -1,0 +1,71 @@
+"""The names a person gives things: "the red cup" names `red_cup`, not `cup`.
+
+An object in RSL is one identifier, and a person often names a thing in
+two words: a kind of thing ("the water bottle", "the toy box") or a thing
+told apart from others ("the red cup"). The translator offers such a pair
+as one name, and the meaning checks doubt a plan that keeps one word of it.
+
+Only a pair that is plainly a whole name is read: it follows a
+determiner and ends the phrase (the end of the clause, or a word that
+cannot be part of a name). "the cup gently", "the keys real quick" and
+"the cup sitting there" name no pair.
+"""
+
+from __future__ import annotations
+
+import re
+from collections import Counter
+from collections.abc import Collection
+
+# Words that come before a thing's name and are never one ("approach a" from "move to the right a bit").
+DETERMINERS = ("the", "a", "an", "some", "that", "this", "my", "your")
+# Words of English's closed classes (pronouns, prepositions, conjunctions, auxiliaries, a few adverbs
+# and quantifiers): never a word of a thing's name, so one after a pair ends it.
+FUNCTION_WORDS = frozenset({"i", "me", "you", "he", "him", "she", "her", "it", "we", "us", "they", "them", "my",
+                            "your", "his", "its", "our", "their", "this", "that", "these", "those", "there", "here",
+                            "to", "from", "on", "in", "of", "at", "by", "with", "for", "into", "onto", "over",
+                            "under", "near", "behind", "beside", "between", "next", "off", "out", "up", "down",
+                            "through", "across", "around", "past", "toward", "towards", "about", "after", "before",
+                            "against", "along", "and", "or", "but", "then", "so", "if", "when", "while", "because",
+                            "once", "until", "unless", "than", "is", "are", "was", "were", "be", "been", "am", "do",
+                            "does", "did", "has", "have", "had", "can", "could", "will", "would", "should", "may",
+                            "might", "must", "please", "now", "again", "too", "also", "just", "very", "really",
+                            "only", "already", "still", "even", "first", "last", "back", "away", "all", "both",
+                            "each", "every", "any", "other", "another", "same", "such", "one", "ones", "thanks",
+                            "thank", "ok", "okay", "um", "uh", "hmm", "yes", "no", "not"})
+# Nouns of place, amount and shape a task says that are never the object a skill acts on.
+NOT_NAMES = frozenset({"left", "right", "start", "origin", "beginning", "way", "same", "other", "front",
+                       "back", "end", "middle", "centre", "center", "robot", "side", "distance", "time",
+                       "little", "bit", "square", "triangle", "circle", "full", "long", "few", "couple",
+                       "point", "position", "spot", "area", "room", "around", "head", "camera"})
+_PAIR = re.compile(rf"\b(?:{'|'.join(DETERMINERS)}) (?=([a-z]+) ([a-z]+)\b(?: ([a-z]+))?)")
+# Endings of words that describe how or what is happening, not what a thing is called.
+_NOT_NAME_ENDINGS = ("ly", "ing")
+
+
+def two_word_names(text: str, not_names: Collection[str] = ()) -> tuple[tuple[str, str], ...]:
+    """The pairs of words `text` names things by ("the red cup" -> ("red", "cup")), in order, once each.
+
+    `not_names` are words that never name a thing here (the robot's skill
+    and direction words: "the left cup" is a cup).
+    """
+    return tuple(dict.fromkeys(_pairs(text, not_names)))
+
+
+def said_only_in_pairs(text: str, not_names: Collection[str] = ()) -> frozenset[str]:
+    """The words of the pairs `text` names things by that it never says on their own ("the red cup")."""
+    inside = Counter(word for pair in _pairs(text, not_names) for word in pair)
+    said = Counter(re.findall(r"[a-z]+", text.lower()))
+    return frozenset(word for word, count in inside.items() if said[word] <= count)
+
+
+def _pairs(text: str, not_names: Collection[str]) -> list[tuple[str, str]]:
+    never = FUNCTION_WORDS | NOT_NAMES | set(DETERMINERS) | set(not_names)
+    pairs = []
+    for m in _PAIR.finditer(text.lower()):
+        first, second, after = m.groups()
+        if (first in never or second in never or second.endswith(_NOT_NAME_ENDINGS)
+                or (after is not None and after not in never)):
+            continue
+        pairs.append((first, second))
+    return pairs
