@@ -62,3 +62,14 @@ def test_summary_counts_verified_programs_that_are_not_what_was_asked(tmp_path: 
     assert list(table) == ["everyday", "refuse", "overall"]
     assert table["refuse"]["wrong_runs"] == 1.0 and table["everyday"]["wrong_runs"] == 0.0
     assert table["overall"]["wrong_runs"] == 0.5
+
+
+# The sets translation is measured on (bench/written holds training pairs in another format).
+BENCH = Path(__file__).parents[2] / "bench"
+MEASURED_SETS = sorted(p for d in ("fresh", "practice") for p in (BENCH / d).glob("*.toml"))
+
+
+@pytest.mark.parametrize("path", MEASURED_SETS, ids=lambda p: f"{p.parent.name}/{p.name}")
+def test_every_bench_task_set_loads_and_its_programs_compile(path: Path) -> None:
+    tasks = load_suite(path, load_profile())
+    assert tasks and all(t.task for t in tasks)
