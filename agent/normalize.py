@@ -132,12 +132,13 @@ def _carry_corrected_units(tokens: list[str]) -> list[str]:
         unit = out[at - 1]
         if unit not in _LENGTHS and unit not in _ANGLES:
             continue
-        j = at + 1 if out[at:at + 1] == [","] else at
+        # Commas may be several: an ellipsis ("30 degrees... no, 60") is read as commas, and so is a
+        # filler's ("30 degrees, uh, no, 60") once the filler is dropped.
+        j = _past_commas(out, at)
         marker = next((m for m in _MARKER_WORDS if tuple(out[j:j + len(m)]) == m), None)
         if marker is None:
             continue
-        j += len(marker)
-        j += 1 if out[j:j + 1] == [","] else 0
+        j = _past_commas(out, j + len(marker))
         parsed = _parse_number(out, j)
         if parsed is None:
             continue
@@ -146,6 +147,12 @@ def _carry_corrected_units(tokens: list[str]) -> list[str]:
             continue
         out.insert(end, unit)
     return out
+
+
+def _past_commas(tokens: Sequence[str], i: int) -> int:
+    while tokens[i:i + 1] == [","]:
+        i += 1
+    return i
 
 
 def _is_number_token(token: str) -> bool:

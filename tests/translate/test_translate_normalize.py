@@ -51,6 +51,8 @@ from agent.normalize import normalize_task
         ("an eighth of a circle", "0.7854 rad"),
         # A bare number that corrects an amount is in the amount's unit.
         ("turn left 30 degrees, no, 60", "turn left 0.5236 rad, no, 1.0472 rad"),
+        # ... even across an ellipsis and a dropped filler, which leave several commas.
+        ("Turn right thirty degrees... uh no, sixty.", "turn right 0.5236 rad, no, 1.0472 rad"),
         ("move 50 centimeters, make that 80", "move 0.5 m, make that 0.8 m"),
         ("go forward three meters, no wait, four", "go forward 3 m, no wait, 4 m"),
         ("turn left 90 degrees, no, 2 times", "turn left 1.5708 rad, no, 2 times"),
