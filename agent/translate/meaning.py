@@ -53,6 +53,12 @@ _SEQUENCE_WORDS = frozenset({"and", "then", "after", "next", "finally", "times",
 # kept still ("keep your head still and turn left"). "why don't you look up" suggests, not negates.
 _NEGATION = re.compile(r"(?<!\bwhy )\b(?:don'?t|do not|never|without|no|not)\b[^,.;]*"
                        r"|\b(?:keep|hold)\s+(?:[a-z]+\s+){0,2}?still\b")
+# A question about the robot, asked and left there ("why do you keep looking up"), is no request;
+# "why don't you look up" suggests ("don't" is no auxiliary here), and a request after it
+# ("what are you waiting for, go forward") is one.
+_QUESTION = re.compile(r"^(?:[a-z]+, )?(?:why|what|where|when|who|which|how) "
+                       r"(?:do|does|did|is|are|was|were|have|has|had|can|could|will|would|should)\b(?!')"
+                       r"(?!.*\bthen\b)[^,;.]*$")
 # The part of the robot that moves itself as a whole: the one a skill is on when its description names no part.
 WHOLE = "base"
 _TOLERANCE = 0.02
@@ -114,6 +120,9 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     doubts += _doubled(text, plan, profile)
     doubts += _carried_out(_named(_WORD.findall(affirmed), vocab), text, plan, vocab)
     doubts += _objects(text, plan, known_objects, vocab)
+    if _QUESTION.match(text):
+        doubts.append(Doubt("question", f"you asked a question, not for the robot to act, but the plan acts "
+                                        f"({say(plan.commands[0], profile)})"))
     return tuple({d.reason: d for d in doubts}.values())
 
 

@@ -119,6 +119,9 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
     # An article is never a thing's name.
     ("move over to the right a bit", "approach a;",
      "the plan takes 'a' for an object, but it is a word that comes before a thing's name"),
+    # A question asked and left there is no request.
+    ("why do you keep looking up at the ceiling?", "lookup 0.5236;",
+     "you asked a question, not for the robot to act, but the plan acts (look up 30°)"),
 ])
 def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str, expected: str,
                                                          profile: Profile) -> None:
@@ -171,6 +174,8 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     # A suggestion is a request, not a negation.
     ("why don't you look up", "lookup 0.5236;"),
     ("why not turn left", "turnleft 1.5708;"),
+    # A question followed by a request.
+    ("what are you waiting for? go forward", "forward 1;"),
     # The same step twice in a row, asked for twice.
     ("turn left 90 degrees, turn left 90 degrees", "turnleft 1.5708; turnleft 1.5708;"),
     ("look up, and look up again", "lookup 0.5236; lookup 0.5236;"),
