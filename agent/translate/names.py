@@ -3,7 +3,7 @@
 An object in RSL is one identifier, and a person often names a thing in
 two words: a kind of thing ("the water bottle", "the toy box") or a thing
 told apart from others ("the red cup"). The translator offers such a pair
-as one name, and the meaning checks doubt a plan that keeps one word of it.
+to the model only as one name.
 
 Only a pair that is plainly a whole name is read: it follows a
 determiner and ends the phrase (the end of the clause, or a word that
@@ -43,23 +43,19 @@ _PAIR = re.compile(rf"\b(?:{'|'.join(DETERMINERS)}) (?=([a-z]+) ([a-z]+)\b(?: ([
 _NOT_NAME_ENDINGS = ("ly", "ing")
 
 
-def two_word_names(text: str, not_names: Collection[str] = ()) -> tuple[tuple[str, str], ...]:
-    """The pairs of words `text` names things by ("the red cup" -> ("red", "cup")), in order, once each.
-
-    `not_names` are words that never name a thing here (the robot's skill
-    and direction words: "the left cup" is a cup).
-    """
-    return tuple(dict.fromkeys(_pairs(text, not_names)))
-
-
 def said_only_in_pairs(text: str, not_names: Collection[str] = ()) -> frozenset[str]:
     """The words of the pairs `text` names things by that it never says on their own ("the red cup")."""
-    inside = Counter(word for pair in _pairs(text, not_names) for word in pair)
+    inside = Counter(word for pair in name_pairs(text, not_names) for word in pair)
     said = Counter(re.findall(r"[a-z]+", text.lower()))
     return frozenset(word for word, count in inside.items() if said[word] <= count)
 
 
-def _pairs(text: str, not_names: Collection[str]) -> list[tuple[str, str]]:
+def name_pairs(text: str, not_names: Collection[str] = ()) -> list[tuple[str, str]]:
+    """The pairs of words `text` names things by ("the red cup" -> ("red", "cup")), each time said.
+
+    `not_names` are words that never name a thing here (the robot's skill
+    and direction words: "the left cup" is a cup).
+    """
     never = FUNCTION_WORDS | NOT_NAMES | set(DETERMINERS) | set(not_names)
     pairs = []
     for m in _PAIR.finditer(text.lower()):

@@ -1,8 +1,8 @@
-"""Which pairs of words name one thing: the translator offers them whole, the checks doubt a plan that splits them."""
+"""Which pairs of words name one thing: the translator offers them to the model only whole."""
 
 import pytest
 
-from agent.translate.names import said_only_in_pairs, two_word_names
+from agent.translate.names import name_pairs, said_only_in_pairs
 
 
 @pytest.mark.parametrize(("text", "pairs"), [
@@ -22,7 +22,7 @@ from agent.translate.names import said_only_in_pairs, two_word_names
     ("look at the left cup", ()),
 ])
 def test_a_pair_is_read_only_when_it_is_plainly_one_name(text: str, pairs: tuple[tuple[str, str], ...]) -> None:
-    assert two_word_names(text, not_names={"left", "right"}) == pairs
+    assert tuple(name_pairs(text, not_names={"left", "right"})) == pairs
 
 
 def test_a_word_said_on_its_own_as_well_is_not_only_in_a_pair() -> None:
