@@ -23,6 +23,13 @@ from agent.ros2.node_thread import NodeThread
 from rsl.profile import PRIMITIVES, Primitive, Profile
 
 DISCOVERY_FLOOR = 2.0  # s a long-running backend still waits for a service or subscriber
+# Discovery is not symmetric: we can match a server that just appeared before it has matched our
+# response reader, and Fast DDS drops a reply to a reader its server has not matched within 100 ms
+# (ros2/ros2#1253). Nothing in ROS shows the server's side of the match, and a Trigger such as
+# dock must not be sent twice, so a request waits until its server has been in sight this long:
+# one retransmission of a lost discovery announcement (Fast DDS repeats them every 1 s) and margin.
+SERVER_SETTLE = 1.5  # s
+SERVER_WATCH_PERIOD = 0.1  # s between looks at whether each client's server is in sight
 
 
 @dataclass(frozen=True)
@@ -67,6 +74,8 @@ class RobotLink:
         self._objects_error = ""
         self._bumper_stop: BumperStop | None = None
         self._bumper_received = 0.0
+        self._clients: list[Any] = []
+        self._server_seen: dict[Any, float] = {}  # client -> time.monotonic() its server came into sight
 
         self._ros = NodeThread(node_name)
         node = self._ros.node
@@ -93,10 +102,11 @@ class RobotLink:
                                  QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT))
         # Reliable: a bumper stop is an event, not a stream whose next message would make up for a lost one.
         node.create_subscription(String, config.bumper, self._on_bumper, reliable)
-        self._perceive = (node.create_client(Trigger, config.perceive_service) if "perception" in needed
-                          else None)
-        self._grasp = node.create_client(Trigger, config.grasp_service) if "gripper" in needed else None
+        self._perceive = self.client(Trigger, config.perceive_service) if "perception" in needed else None
+        self._grasp = self.client(Trigger, config.grasp_service) if "gripper" in needed else None
         self._trigger_request = Trigger.Request
+        # Watched from the start, so a server found long before its first call is not made to wait.
+        node.create_timer(SERVER_WATCH_PERIOD, self._watch_servers)
 
     # -- incoming --------------------------------------------------------------
 
@@ -232,7 +242,10 @@ class RobotLink:
         return self._ros.node.create_publisher(msg_type, topic, self._reliable)
 
     def client(self, srv_type: Any, service: str) -> Any:
-        return self._ros.node.create_client(srv_type, service)
+        client = self._ros.node.create_client(srv_type, service)
+        with self._lock:
+            self._clients.append(client)
+        return client
 
     def send_trajectory(self, publisher: object, joints: list[str], positions: list[float],
                         duration: float) -> None:
@@ -258,10 +271,8 @@ class RobotLink:
 
     def call(self, client: object, name: str, cancel: CancelToken, request: object | None = None) -> ServiceReply:
         """Call a service whose response has `success` and `message` (std_srvs Trigger, SetBool)."""
+        self._await_server(client, name, cancel)
         timeout = self.config.service_timeout
-        if not client.wait_for_service(timeout_sec=self.discovery_wait()):  # type: ignore[attr-defined]
-            raise ServiceError(f"service {name} is not available; is the robot's driver "
-                               "(or `nrtrans sim-bridge`) running and offering it?")
         future = client.call_async(request or self._trigger_request())  # type: ignore[attr-defined]
         answered = threading.Event()
         future.add_done_callback(lambda _f: answered.set())
@@ -274,6 +285,38 @@ class RobotLink:
                 raise ServiceError(f"service {name} did not answer within {timeout:g} s")
         response = future.result()
         return ServiceReply(bool(response.success), str(response.message))
+
+    def _await_server(self, client: object, name: str, cancel: CancelToken) -> None:
+        """Return once `client`'s server has been in sight for SERVER_SETTLE s; raise if it does not
+        appear within `discovery_wait` or the call is cancelled first, before anything was sent."""
+        deadline = time.monotonic() + self.discovery_wait()
+        while True:
+            if cancel.is_set():
+                raise ServiceError(f"call to {name} abandoned: {cancel.reason}")
+            now = time.monotonic()
+            seen = self._server_in_sight(client, now)
+            if seen is not None and now - seen >= SERVER_SETTLE:
+                return
+            if seen is None and now > deadline:
+                raise ServiceError(f"service {name} is not available; is the robot's driver "
+                                   "(or `nrtrans sim-bridge`) running and offering it?")
+            time.sleep(0.02)
+
+    def _server_in_sight(self, client: Any, now: float) -> float | None:
+        """Since when `client`'s server has been discovered without a break, or None while it is not."""
+        ready = client.service_is_ready()
+        with self._lock:
+            if not ready:
+                self._server_seen.pop(client, None)
+                return None
+            return self._server_seen.setdefault(client, now)
+
+    def _watch_servers(self) -> None:
+        now = time.monotonic()
+        with self._lock:
+            clients = list(self._clients)
+        for client in clients:
+            self._server_in_sight(client, now)
 
     def discovery_wait(self) -> float:
         """Seconds to wait for a service or a subscriber to be discovered before calling it missing.
