@@ -5,6 +5,8 @@ Each test owns its bridge."""
 from __future__ import annotations
 
 import dataclasses
+import json
+import os
 import subprocess
 import sys
 import threading
@@ -19,11 +21,13 @@ from agent.ros2.backend import RobotUnavailable, Ros2Robot
 from agent.ros2.bridge import SimBridge
 from agent.ros2.config import RosConfig
 from agent.ros2.link import interfaces_needed, primitives_used
+from agent.ros2.node_thread import NodeThread
 from agent.sim.scene import load_scene
 from agent.sim.world import SimWorld
 from rsl.profile import Profile, parse_profile
 
 from .conftest import REPO, ROS_ENV, Bridge
+from .slow_announcer import SLOW_DISCOVERY
 
 pytestmark = pytest.mark.timeout(120)
 
@@ -95,3 +99,44 @@ def test_a_robot_that_only_grasps_is_offered_the_look_a_grasp_falls_back_on(prof
         assert bridge.config.grasp_service in bridge.interfaces
     finally:
         bridge.close()
+
+
+@pytest.mark.skipif(os.environ.get("RMW_IMPLEMENTATION", "rmw_fastrtps_cpp") != "rmw_fastrtps_cpp",
+                    reason="the profile that slows discovery down is Fast DDS's")
+def test_a_server_that_discovers_the_caller_late_is_called_once_and_its_reply_arrives(tmp_path: Path) -> None:
+    """A server that appears while a backend waits for it can accept the request before it has matched the
+    backend's response reader; Fast DDS then drops the reply after 100 ms (ros2/ros2#1253), which is how
+    a late /dock on a loaded machine failed now and then. Here the backend's announcements trickle out, so
+    the server learns of its response reader about 0.4 s after its request writer on every run."""
+    from std_srvs.srv import Trigger
+
+    profile = tmp_path / "slow_discovery.xml"
+    profile.write_text(SLOW_DISCOVERY, encoding="utf-8")
+    name = "/late/slow_dock"
+    caller = subprocess.Popen(
+        [sys.executable, "-m", "tests.ros2.slow_announcer", name], cwd=REPO, text=True,
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+        env={**os.environ, **ROS_ENV, "FASTDDS_DEFAULT_PROFILES_FILE": str(profile), "PYTHONPATH": str(REPO)})
+    calls: list[float] = []
+    server: NodeThread | None = None
+    try:
+        assert caller.stdout is not None
+        assert caller.stdout.readline().strip() == "calling", caller.communicate(timeout=30)[1]
+        server = NodeThread("nrtrans_test_slow_dock")
+
+        def dock(_request: object, response: object) -> object:
+            calls.append(time.monotonic())
+            response.success, response.message = True, "docked"  # type: ignore[attr-defined]
+            return response
+
+        server.node.create_service(Trigger, name, dock)
+        out, err = caller.communicate(timeout=60)
+    finally:
+        if caller.poll() is None:
+            caller.kill()
+            caller.wait()
+        if server is not None:
+            server.close()
+    assert caller.returncode == 0, err
+    assert json.loads(out.splitlines()[-1]) == {"success": True, "message": "docked"}, err
+    assert len(calls) == 1, "a request to a dock must not be repeated"
