@@ -258,7 +258,24 @@ def _with_unit(tokens: Sequence[str], value: float, j: int, *, explicit: bool) -
     # "two meters and a half", "a meter and a half"
     if tokens[end:end + 3] == ["and", "a", "half"]:
         value, end = value + 0.5, end + 3
-    return f"{format_number(value * factor)} {name}", end
+    total = value * factor
+    if name == "m":
+        # "two feet six inches", "a metre and twenty centimetres": one length said in two units.
+        # Left as two lengths, the model drives the first and drops or adds the second.
+        total, end = _smaller_length_after(tokens, end, factor, total)
+    return f"{format_number(total)} {name}", end
+
+
+def _smaller_length_after(tokens: Sequence[str], end: int, factor: float, total: float) -> tuple[float, int]:
+    """`total` with a length in a smaller unit that follows at tokens[end] added, and the index after it."""
+    start = end + 1 if tokens[end:end + 1] == ["and"] else end
+    parsed = _parse_number(tokens, start)
+    if parsed is None or parsed[0] <= 0:
+        return total, end
+    value, j = parsed
+    if j >= len(tokens) or _LENGTHS.get(tokens[j], factor) >= factor:
+        return total, end
+    return total + value * _LENGTHS[tokens[j]], j + 1
 
 
 def _convert_numbers(tokens: list[str]) -> list[str]:

@@ -61,6 +61,14 @@ from agent.normalize import normalize_task
         ("turn left 90", "turn left 1.5708 rad"),
         ("rotate clockwise by forty five", "rotate clockwise by 0.7854 rad"),
         ("go forward 2 then turn right 180", "go forward 2 then turn right 3.1416 rad"),
+        # One length said in two units is one amount: their sum.
+        ("roll forward two feet six inches", "roll forward 0.762 m"),
+        ("move forward one metre and twenty centimetres", "move forward 1.2 m"),
+        ("back up a meter and a half and ten centimeters", "back up 1.6 m"),
+        # ... but not two lengths, nor a larger unit after a smaller one.
+        ("forward 2 m and 3 m", "forward 2 m and 3 m"),
+        ("forward 1 m and back 20 cm", "forward 1 m and back 0.2 m"),
+        ("go 30 cm and 2 m", "go 0.3 m and 2 m"),
     ],
 )
 def test_normalize_converts_numbers_units_and_fillers(task: str, expected: str) -> None:
