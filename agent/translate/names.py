@@ -13,6 +13,7 @@ cannot be part of a name). "the cup gently", "the keys real quick" and
 
 from __future__ import annotations
 
+import itertools
 import re
 from collections import Counter
 from collections.abc import Collection
@@ -30,7 +31,8 @@ FUNCTION_WORDS = frozenset({"i", "me", "you", "he", "him", "she", "her", "it", "
                             "once", "until", "unless", "than", "is", "are", "was", "were", "be", "been", "am", "do",
                             "does", "did", "has", "have", "had", "can", "could", "will", "would", "should", "may",
                             "might", "must", "please", "now", "again", "too", "also", "just", "very", "really",
-                            "only", "already", "still", "even", "first", "last", "back", "away", "all", "both",
+                            "only", "already", "still", "even", "first", "last", "back", "away", "instead", "though",
+                            "anyway", "all", "both",
                             "each", "every", "any", "other", "another", "same", "such", "one", "ones", "thanks",
                             "thank", "ok", "okay", "um", "uh", "hmm", "yes", "no", "not"})
 # Nouns of place, amount and shape a task says that are never the object a skill acts on.
@@ -65,3 +67,23 @@ def name_pairs(text: str, not_names: Collection[str] = ()) -> list[tuple[str, st
             continue
         pairs.append((first, second))
     return pairs
+
+
+def offered_names(text: str, not_names: Collection[str] = ()) -> tuple[str, ...]:
+    """The words and pairs of words (`water_bottle`) of a whole task that may name the object a skill acts
+    on, in the order said; the model chooses among them.
+
+    Any word may ("pick up the book gently" is `book`), but a word of a pair that is plainly one name
+    is offered only in the pair: a model trained on one-word names would keep one word of "the red
+    cup" and lose which thing was meant. A closed-class word ("and", "it", "instead") names nothing
+    unless a determiner says it does ("grasp the can"): offered, the model wrote `approach bottle_and;`
+    for "the water bottle and pick it up". `not_names` as for `name_pairs`.
+    """
+    in_pairs = said_only_in_pairs(text, not_names)
+    said = re.findall(r"[a-z]+", text.lower())
+    named = [word not in NOT_NAMES and word not in DETERMINERS and (word not in FUNCTION_WORDS or before in DETERMINERS)
+             for before, word in zip(["", *said], said, strict=False)]
+    words = [word for word, ok in zip(said, named, strict=True) if ok and word not in in_pairs]
+    pairs = [f"{a}_{b}" for (a, b), ok in zip(itertools.pairwise(said), itertools.pairwise(named), strict=False)
+             if all(ok)]
+    return tuple(dict.fromkeys((*words, *pairs)))

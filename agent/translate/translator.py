@@ -27,7 +27,7 @@ from agent.translate.confidence import Assessment, assess, model_signal, result_
 from agent.translate.engine import CancelFlag, Fork, Generation
 from agent.translate.meaning import skill_words
 from agent.translate.model_path import ModelNotFoundError
-from agent.translate.names import DETERMINERS, NOT_NAMES, said_only_in_pairs
+from agent.translate.names import DETERMINERS, NOT_NAMES, offered_names
 from agent.translate.prompt import (
     Shot,
     chat_prompt,
@@ -468,15 +468,8 @@ class Translator:
         if not self.options.narrow:
             return None
         if not self.options.split_clauses:
-            # A whole task: any word or pair of words it says may name an object, and the model decides
-            # which ("pick up the book gently" is `book`). A pair that is plainly one name ("the red
-            # cup") is offered only whole: a model trained on one-word names would keep one word of it
-            # and lose which thing was meant.
-            in_pairs = said_only_in_pairs(text, skill_words(self.profile))
-            words = [w for w in re.findall(r"[a-z]+", text) if w not in NOT_NAMES]
-            pairs = [f"{a}_{b}" for a, b in itertools.pairwise(words)]
-            words = [w for w in words if w not in in_pairs]
-            return tuple(dict.fromkeys(w for w in (*words, *pairs) if IDENTIFIER.match(w))) or None
+            # A whole task: the model decides which of the words and pairs it says names the object.
+            return tuple(n for n in offered_names(text, skill_words(self.profile)) if IDENTIFIER.match(n)) or None
         names: list[str] = []
         for phrase in _OBJECT_PHRASE.findall(text):
             words = phrase.split()

@@ -2,7 +2,7 @@
 
 import pytest
 
-from agent.translate.names import name_pairs, said_only_in_pairs
+from agent.translate.names import name_pairs, offered_names, said_only_in_pairs
 
 
 @pytest.mark.parametrize(("text", "pairs"), [
@@ -29,3 +29,19 @@ def test_a_word_said_on_its_own_as_well_is_not_only_in_a_pair() -> None:
     assert said_only_in_pairs("go to the red cup") == {"red", "cup"}
     assert said_only_in_pairs("go to the red cup, then pick up the cup") == {"red"}
     assert said_only_in_pairs("go to the red cup, then the red cup again") == {"red", "cup"}
+
+
+@pytest.mark.parametrize(("text", "offered"), [
+    # A pair plainly one name is offered whole; its words alone are not.
+    ("pick up the red cup", ("pick", "red_cup")),
+    # A closed-class word names nothing, alone or in a pair ...
+    ("go over to the water bottle and pick it up", ("go", "pick", "water_bottle")),
+    ("fetch the orange instead", ("fetch", "orange")),
+    # ... unless a determiner says it does.
+    ("grasp the can", ("grasp", "can")),
+    # Other words stay, alone and with their neighbours: the model picks.
+    ("pick up the book gently", ("pick", "book", "gently", "book_gently")),
+])
+def test_a_whole_task_offers_the_words_that_may_name_a_thing(text: str, offered: tuple[str, ...]) -> None:
+    assert offered_names(text, not_names={"left", "right"}) == offered
+
