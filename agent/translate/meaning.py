@@ -50,14 +50,18 @@ _AGAIN_WORDS = ("again", "another", "more")
 _AGAIN = re.compile(rf"\b(?:{'|'.join(_AGAIN_WORDS)}|repeat\w*|twice)\b")
 _SEQUENCE_WORDS = frozenset({"and", "then", "after", "next", "finally", "times", *_AGAIN_WORDS})
 # What negates what follows it up to the end of its clause ("don't move, just look left"), and a part
-# kept still ("keep your head still and turn left"). "why don't you look up" suggests, not negates.
+# kept still ("keep your head still and turn left", "keep your head where it is"). "why don't you look up"
+# suggests, not negates.
 _NEGATION = re.compile(r"(?<!\bwhy )\b(?:don'?t|do not|never|without|no|not)\b[^,.;]*"
-                       r"|\b(?:keep|hold)\s+(?:[a-z]+\s+){0,2}?still\b")
+                       r"|\b(?:keep|hold)\s+(?:[a-z]+\s+){0,2}?(?:still|steady|in place|where it is|as it is)\b")
 # A question about the robot, asked and left there ("why do you keep looking up"), is no request;
 # "why don't you look up" suggests ("don't" is no auxiliary here), and a request after it
 # ("what are you waiting for, go forward") is one.
-_QUESTION = re.compile(r"^(?:[a-z]+, )?(?:why|what|where|when|who|which|how) "
-                       r"(?:do|does|did|is|are|was|were|have|has|had|can|could|will|would|should)\b(?!')"
+# A question about what was done ("did you go forward earlier") is no request either; "can you",
+# "would you" and "do you mind" ask for the act, so only the past and perfect auxiliaries count.
+_QUESTION = re.compile(r"^(?:[a-z]+, )?(?:(?:why|what|where|when|who|which|how) "
+                       r"(?:do|does|did|is|are|was|were|have|has|had|can|could|will|would|should)"
+                       r"|(?:did|was|were|have|has|had) (?:you|it|we|they|i))\b(?!')"
                        r"(?!.*\bthen\b)[^,;.]*$")
 # The part of the robot that moves itself as a whole: the one a skill is on when its description names no part.
 WHOLE = "base"

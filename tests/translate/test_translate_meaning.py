@@ -68,6 +68,10 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
      "you said not to move the head, but the plan does (look left 30°)"),
     ("hold the camera still, then turn right", "lookright 0.5236; turnright 1.5708;",
      "you said not to move the head, but the plan does (look right 30°)"),
+    ("keep your head where it is and turn right 20 degrees", "lookright 0.5236; turnright 0.3491;",
+     "you said not to move the head, but the plan does (look right 30°)"),
+    ("hold the camera steady and spin left", "lookright 0.5236; turnleft 1.5708;",
+     "you said not to move the head, but the plan does (look right 30°)"),
     ("repeat a turn until a full circle", "turnleft 6.2832; turnleft 6.2832; turnleft 6.2832;",
      "you said 360° of turn in all, but the plan turns 1080°"),
     ("turn right 90 degrees", "turnleft 1.5708;", "you said right, but the plan goes the other way (turn left 90°)"),
@@ -121,6 +125,11 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
      "the plan takes 'a' for an object, but it is a word that comes before a thing's name"),
     # A question asked and left there is no request.
     ("why do you keep looking up at the ceiling?", "lookup 0.5236;",
+     "you asked a question, not for the robot to act, but the plan acts (look up 30°)"),
+    # ... and so is one about what was done.
+    ("did you go forward two metres earlier?", "forward 2;",
+     "you asked a question, not for the robot to act, but the plan acts (drive forward 2 m)"),
+    ("have you looked up at the shelf yet", "lookup 0.5236;",
      "you asked a question, not for the robot to act, but the plan acts (look up 30°)"),
 ])
 def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str, expected: str,
@@ -176,6 +185,9 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     ("why not turn left", "turnleft 1.5708;"),
     # A question followed by a request.
     ("what are you waiting for? go forward", "forward 1;"),
+    # A question that asks for the act is a request.
+    ("could you turn left", "turnleft 1.5708;"),
+    ("would you go forward a meter", "forward 1;"),
     # The same step twice in a row, asked for twice.
     ("turn left 90 degrees, turn left 90 degrees", "turnleft 1.5708; turnleft 1.5708;"),
     ("look up, and look up again", "lookup 0.5236; lookup 0.5236;"),
