@@ -24,7 +24,7 @@ from agent.normalize import normalize_task
 from agent.translate.automaton import RslAutomaton
 from agent.translate.clauses import Clause, split_clauses
 from agent.translate.confidence import Assessment, assess, model_signal, result_fields
-from agent.translate.engine import CancelFlag, Fork, Generation
+from agent.translate.engine import FORK_RECORD_FLOOR, CancelFlag, Fork, Generation
 from agent.translate.meaning import skill_words
 from agent.translate.model_path import ModelNotFoundError
 from agent.translate.names import DETERMINERS, NOT_NAMES, offered_names
@@ -62,8 +62,10 @@ _PHRASE_END = frozenset({"with", "and", "for", "to", "from", "on", "in", "of", "
 ENDING_FLOOR = 0.05
 # When a program fails a meaning check and no earlier ending passes, the model's runner-up tokens at
 # least this likely are tried, the likeliest first and at most MAX_FORKS of them (a generation each).
-# Set before any measurement, not fitted to a task set.
-FORK_FLOOR = 0.1
+# Every runner-up the engine records: "turn left 2 times" came out as two 2 rad turns where the
+# model's runner-up for the amount, "1", was 8% likely. A fork's program is always questioned (its
+# runner-up's probability is in the model's signal), so a lower floor cannot make one run unasked.
+FORK_FLOOR = FORK_RECORD_FLOOR
 MAX_FORKS = 2
 
 # Another program for a whole task: its text, plan, the model's probabilities and the assessment.

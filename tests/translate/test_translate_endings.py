@@ -106,6 +106,14 @@ def test_a_failed_check_takes_the_model_s_other_choice_that_passes(translator: T
     assert probabilities[0] == 0.99
 
 
+def test_every_runner_up_the_engine_records_is_tried_and_its_program_is_questioned(translator: Translator) -> None:
+    state = _wrong_turn(translator, runner_up=0.08)  # "1" for the amount of "turn left 2 times" was 8% likely
+    found = translator._other_choice(state, state.clause.text, None, None, {"prompt": 0.0, "generate": 0.0})
+    assert found is not None
+    program, _plan, _probabilities, assessment = found
+    assert program == "turnright 1.5708;\n" and assessment.unsure
+
+
 def test_a_runner_up_the_model_hardly_weighed_is_not_tried(translator: Translator) -> None:
     state = _wrong_turn(translator, runner_up=FORK_FLOOR / 2)
     timings = {"prompt": 0.0, "generate": 0.0}
