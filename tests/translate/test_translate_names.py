@@ -44,4 +44,3 @@ def test_a_word_said_on_its_own_as_well_is_not_only_in_a_pair() -> None:
 ])
 def test_a_whole_task_offers_the_words_that_may_name_a_thing(text: str, offered: tuple[str, ...]) -> None:
     assert offered_names(text, not_names={"left", "right"}) == offered
-
