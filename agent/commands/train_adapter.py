@@ -125,6 +125,7 @@ def _train(args: argparse.Namespace) -> int:
         return _fail(str(exc))
 
     import torch
+    import transformers
 
     groups: dict[str, int] = {}
     for pair in pairs:
@@ -141,7 +142,8 @@ def _train(args: argparse.Namespace) -> int:
                   "loss_every_50": [round(x, 4) for x in result.losses[::50]],
                   "train_seconds": round(result.seconds, 1),
                   "total_seconds": round(time.monotonic() - started, 1), "device": result.device,
-                  "threads": recipe.threads, "torch": torch.__version__, "machine": platform.machine()})
+                  "threads": recipe.threads, "torch": torch.__version__,
+                  "transformers": transformers.__version__, "machine": platform.machine()})
     # Written before scoring too: the runtime reads the card (prompt format) when it loads the adapter.
     card.write(card_path(out))
     if held_out:

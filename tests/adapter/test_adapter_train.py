@@ -9,7 +9,7 @@ from agent.adapter.card import read_card
 from agent.adapter.data import generate
 from agent.adapter.evaluate import complete, load
 from agent.adapter.recipe import Recipe
-from agent.adapter.train import native_bf16, train
+from agent.adapter.train import TrainingError, check_tokenizer, native_bf16, train
 from rsl.profile import Profile
 from tests.adapter.conftest import requires
 
@@ -58,3 +58,32 @@ def test_the_frozen_base_runs_in_bfloat16_only_where_the_device_multiplies_it_na
     assert native_bf16("cpu", "Features\t: fp asimd evtstrm bf16 i8mm\n")
     assert not native_bf16("cpu", "")
     assert native_bf16("cuda", "")
+
+
+class _PiecewiseTokenizer:
+    """Splits each word into letters, each a real token of the model's vocabulary, the way transformers 5.17's
+    GGUF tokenizer split "lookup" into pieces that llama.cpp never feeds the model."""
+
+    def __init__(self, base_gguf: Path) -> None:
+        import llama_cpp
+
+        self.vocab = llama_cpp.Llama(str(base_gguf), vocab_only=True, verbose=False)
+
+    def encode(self, text: str, add_special_tokens: bool = False) -> list[int]:
+        ids: list[int] = []
+        for char in text:
+            ids.extend(self.vocab.tokenize(char.encode(), add_bos=False, special=False))
+        return ids
+
+
+def test_training_refuses_a_tokenizer_that_splits_text_unlike_llama_cpp(profile: Profile, base_gguf: Path) -> None:
+    pairs = generate(profile, 8, seed=3)
+    try:
+        check_tokenizer(_PiecewiseTokenizer(base_gguf), base_gguf, pairs)
+    except TrainingError as exc:
+        message = str(exc)
+    else:
+        raise AssertionError("a tokenizer that splits text unlike llama.cpp was accepted")
+    assert "llama.cpp" in message and "transformers" in message
+    assert pairs[0].prompt.splitlines()[0][:20] in message  # where: the text that tokenized differently
+
