@@ -134,10 +134,9 @@ def check_tokenizer(tokenizer: Any, base_gguf: Path, pairs: Sequence[Pair]) -> N
             ours = tokenizer.encode(text, add_special_tokens=False)
             theirs = vocab.tokenize(text.encode("utf-8"), add_bos=False, special=False)
             if list(ours) != list(theirs):
-                import transformers
-
+                version = getattr(sys.modules.get("transformers"), "__version__", "(version unknown)")
                 raise TrainingError(
-                    f"the tokenizer transformers {transformers.__version__} builds from {base_gguf.name} splits "
+                    f"the tokenizer transformers {version} builds from {base_gguf.name} splits "
                     f"text unlike llama.cpp, which runs the adapter:\n"
                     f"  text:      {text!r}\n"
                     f"  training:  {len(ours)} tokens {list(ours)[:12]}\n"

@@ -5,6 +5,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
+
 from agent.adapter.card import read_card
 from agent.adapter.data import generate
 from agent.adapter.evaluate import complete, load
@@ -78,12 +80,8 @@ class _PiecewiseTokenizer:
 
 def test_training_refuses_a_tokenizer_that_splits_text_unlike_llama_cpp(profile: Profile, base_gguf: Path) -> None:
     pairs = generate(profile, 8, seed=3)
-    try:
+    with pytest.raises(TrainingError) as refused:
         check_tokenizer(_PiecewiseTokenizer(base_gguf), base_gguf, pairs)
-    except TrainingError as exc:
-        message = str(exc)
-    else:
-        raise AssertionError("a tokenizer that splits text unlike llama.cpp was accepted")
+    message = str(refused.value)
     assert "llama.cpp" in message and "transformers" in message
     assert pairs[0].prompt.splitlines()[0][:20] in message  # where: the text that tokenized differently
-
