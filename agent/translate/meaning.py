@@ -36,7 +36,10 @@ _NUMBER_UNIT = re.compile(r"(?<![\w.])(-?\d*\.?\d+)(?: (m|rad)\b)?")
 _COUNT = re.compile(r"\b(\d+) times\b")
 # A step said after a count: "3 times then turn right", "twice and look up".
 _STEP_AFTER = re.compile(r",?\s*(?:and\s+then|and|then)\s+[a-z]")
-_CLAUSE_START = re.compile(r"(?:^|[,.;]|\band\b|\bthen\b)\s*([a-z]+)")
+# The word that starts a clause, or follows a conjunction, a subject or a modal ("so head over", "if you
+# could head over"); the word itself is not consumed, so "and then head" finds "head" after "then".
+_CLAUSE_START = re.compile(r"(?:^|[,.;]|\b(?:and|then|so|but|or|you|to|can|could|would|will|should|must)\b)"
+                           r"\s*(?=([a-z]+))")
 # What a self-correction takes back: the number or the word right before its marker, when another follows.
 _CORRECTED = rf",?\s+(?:{'|'.join(MARKERS)}),?\s+(?:the |a |an )?"
 _TAKEN_BACK_NUMBER = re.compile(rf"(?<![\w.])(-?\d*\.?\d+)(?: (?:m|rad)\b)?{_CORRECTED}(?=-?\d*\.?\d)")
@@ -316,15 +319,16 @@ def _directions(plan: Plan, vocab: _Vocabulary, words: set[str], named: list[_Co
     allowed = {skill for c in named for skill in c.skills}
     doubts = []
     for skill, mine, opposite, theirs in vocab.directions:
-        for said_words, unsaid_words, wrong in ((mine, theirs, opposite), (theirs, mine, skill)):
+        # "pan left then right" says the head's ways in the words the base's turns are told apart by. The
+        # keyword itself is no way: "look" would be said of both, as its inflections' prefix.
+        ways = [frozenset({raw} & vocab.direction_words) or said_words
+                for said_words, raw in zip((mine, theirs), _difference(skill, opposite), strict=True)]
+        for said_words, unsaid_words, wrong in ((ways[0], ways[1], opposite), (ways[1], ways[0], skill)):
             if _said(words, said_words) and not _said(words, unsaid_words):
                 hit = next((c for c in plan if c.skill == wrong), None)
                 if hit is not None:
                     doubts.append(Doubt("direction", f"you said {min(said_words)}, but the plan goes the "
                                                      f"other way ({say(hit, profile)})"))
-        # "pan left then right" says the head's ways in the words the base's turns are told apart by.
-        ways = [said_words | ({raw} & vocab.direction_words)
-                for said_words, raw in zip((mine, theirs), _difference(skill, opposite), strict=True)]
         both = [c for c in plan if c.skill in (skill, opposite) and c.skill not in allowed]
         if {c.skill for c in both} == {skill, opposite} and not all(_said(words, way) for way in ways):
             back = next(c for c in both if c.skill != both[0].skill)

@@ -75,6 +75,12 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
     ("repeat a turn until a full circle", "turnleft 6.2832; turnleft 6.2832; turnleft 6.2832;",
      "you said 360° of turn in all, but the plan turns 1080°"),
     ("turn right 90 degrees", "turnleft 1.5708;", "you said right, but the plan goes the other way (turn left 90°)"),
+    # The head pans the ways the base turns; "look" is no way, though both pans' keywords start with it.
+    ("look left", "lookright 0.5236;", "you said left, but the plan goes the other way (look right 30°)"),
+    ("turn left, just your head, 45 degrees", "turnleft 1.5708; lookright 0.7854;",
+     "you said left, but the plan goes the other way (look right 45°)"),
+    ("look to the left", "lookleft 0.5236; lookright 0.5236;",
+     "the plan goes both ways (look left 30°, then look right 30°), but you did not say both left and right"),
     ("go back 1 meter", "forward 1;", "you said back, but the plan goes the other way (drive forward 1 m)"),
     ("grasp the cup", "grasp box;", "the plan uses the box, which you did not mention"),
     ("drive forward 2 meters", "forward 3;", "you said 2 m, but the plan never uses it"),
@@ -170,6 +176,10 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     # A part's noun first in its clause is a verb.
     ("head over to the table", "approach table;"),
     ("robot, head back to where you started", "goto 0, 0;"),
+    # ... and so is one after a conjunction, a subject or a modal.
+    ("I'm busy, so head over to the door", "approach door;"),
+    ("it'd be great if you could head over to the couch", "approach couch;"),
+    ("turn left and then head to the table", "turnleft 1.5708; approach table;"),
     # What a self-correction takes back need not be in the plan.
     ("go forward one meter, no wait, two meters", "forward 2;"),
     ("grab the cup, no, the keys", "grasp keys;"),
