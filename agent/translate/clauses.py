@@ -12,6 +12,7 @@ import math
 import re
 from dataclasses import dataclass
 
+from agent.translate.names import NOT_NAMES
 from rsl.plan import format_number
 from rsl.profile import Profile
 
@@ -22,8 +23,9 @@ _REPEAT_ALL = re.compile(r"^(?:repeat|do)(?: (?:that|this|it|all|everything|the 
                          r"(?: again)?(?: (?P<count>\d+) times)?$")
 _OBJECT = re.compile(r"\bthe ((?:[a-z]+ )?[a-z]+)\b")
 _PRONOUN = re.compile(r"\b(it|them|that one)\b")
-_NOT_OBJECTS = {"left", "right", "start", "origin", "beginning", "way", "same", "other", "floor", "front",
-                "back", "end", "middle", "centre", "center", "robot", "side", "distance", "time", "room"}
+# What "it" may stand for: never a word that names no thing, nor the floor things lie on, which names
+# one only in a pair ("the floor lamp").
+_NOT_OBJECTS = NOT_NAMES | {"floor"}
 
 
 @dataclass(frozen=True)

@@ -37,7 +37,7 @@ FUNCTION_WORDS = frozenset({"i", "me", "you", "he", "him", "she", "her", "it", "
                             "thank", "ok", "okay", "um", "uh", "hmm", "yes", "no", "not"})
 # Nouns of place, amount and shape a task says that are never the object a skill acts on.
 NOT_NAMES = frozenset({"left", "right", "start", "origin", "beginning", "way", "same", "other", "front",
-                       "back", "end", "middle", "centre", "center", "robot", "side", "distance", "time",
+                       "back", "end", "middle", "centre", "center", "robot", "side", "distance", "time", "times",
                        "little", "bit", "square", "triangle", "circle", "full", "long", "few", "couple",
                        "point", "position", "spot", "area", "room", "around", "head", "camera"})
 _PAIR = re.compile(rf"\b(?:{'|'.join(DETERMINERS)}) (?=([a-z]+) ([a-z]+)\b(?: ([a-z]+))?)")

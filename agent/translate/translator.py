@@ -27,7 +27,7 @@ from agent.translate.confidence import Assessment, assess, model_signal, result_
 from agent.translate.engine import FORK_RECORD_FLOOR, CancelFlag, Fork, Generation
 from agent.translate.meaning import skill_words
 from agent.translate.model_path import ModelNotFoundError
-from agent.translate.names import DETERMINERS, NOT_NAMES, offered_names
+from agent.translate.names import DETERMINERS, FUNCTION_WORDS, NOT_NAMES, offered_names
 from agent.translate.prompt import (
     Shot,
     chat_prompt,
@@ -54,8 +54,6 @@ DEFAULT_SHOTS = 0
 _NUMBER = re.compile(r"-?\d*\.?\d+")
 _NUMBER_UNIT = re.compile(r"(-?\d*\.?\d+)(?: (m|rad)\b)?")
 _OBJECT_PHRASE = re.compile(rf"\b(?:{'|'.join(DETERMINERS)}) ((?:[a-z]+ )?[a-z]+)\b")
-_PHRASE_END = frozenset({"with", "and", "for", "to", "from", "on", "in", "of", "at", "by", "then", "it", "up",
-                         "down", "again", "into", "onto", "over", "under", "near", "there", "here", "times"})
 
 # The least probability the model must have given to ending a program early for that ending to be
 # tried when the whole program fails a meaning check (see Translator._shorter_ending).
@@ -475,9 +473,9 @@ class Translator:
         names: list[str] = []
         for phrase in _OBJECT_PHRASE.findall(text):
             words = phrase.split()
-            if len(words) == 2 and words[1] in _PHRASE_END:
+            if len(words) == 2 and words[1] in FUNCTION_WORDS:
                 words = words[:1]
-            words = [w for w in words if w not in NOT_NAMES and w not in _PHRASE_END]
+            words = [w for w in words if w not in NOT_NAMES and w not in FUNCTION_WORDS]
             if not words:
                 continue
             names.append(words[-1])

@@ -65,3 +65,9 @@ def test_clauses_split_on_actions_not_on_coordinates(profile: Profile) -> None:
     square = split_clauses("go to 1, 1, perceive, then drive in a square with 2 m sides", profile)
     assert [c.text for c in square[:4]] == ["go to 1, 1", "perceive", "drive forward 2 m", "turn left 1.5708 rad"]
     assert square[-1].repeat_previous and square[-1].repeat == 4 and square[-1].span == 2
+
+
+def test_it_never_stands_for_a_place_or_amount(profile: Profile) -> None:
+    # The splitter reads "it" with the translator's own list of words that name no thing.
+    clauses = split_clauses("go over to the spot, then look at it", profile)
+    assert [c.text for c in clauses] == ["go over to the spot", "look at it"]

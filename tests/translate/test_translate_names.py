@@ -3,6 +3,8 @@
 import pytest
 
 from agent.translate.names import name_pairs, offered_names, said_only_in_pairs
+from agent.translate.translator import Options, Translator
+from rsl.profile import load_profile
 
 
 @pytest.mark.parametrize(("text", "pairs"), [
@@ -44,3 +46,18 @@ def test_a_word_said_on_its_own_as_well_is_not_only_in_a_pair() -> None:
 ])
 def test_a_whole_task_offers_the_words_that_may_name_a_thing(text: str, offered: tuple[str, ...]) -> None:
     assert offered_names(text, not_names={"left", "right"}) == offered
+
+
+class _NoEngine:
+    def close(self) -> None: ...
+
+
+@pytest.mark.parametrize(("clause", "objects"), [
+    ("pick up the cup please", ("cup",)),
+    ("grasp the cup now", ("cup",)),
+    ("approach the red cup", ("cup", "red_cup")),
+])
+def test_a_clause_offers_its_object_without_the_words_said_after_it(clause: str, objects: tuple[str, ...]) -> None:
+    # One clause at a time (the base model's mode): an object phrase ends at any closed-class word.
+    translator = Translator(load_profile(), _NoEngine(), "none", Options(split_clauses=True))  # type: ignore[arg-type]
+    assert translator._task_objects(clause) == objects
