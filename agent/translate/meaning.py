@@ -83,14 +83,13 @@ class Doubt:
 class _Vocabulary:
     parts: dict[str, str]  # skill keyword -> part ("base", "head", "gripper")
     part_words: dict[str, frozenset[str]]  # part -> words that name it or its skills, unshared
-    directions: tuple[tuple[str, frozenset[str], str, frozenset[str]], ...]  # (skill, words, opposite, words)
+    directions: tuple[tuple[str, frozenset[str], str, frozenset[str]], ...]  # (skill, way, opposite, way)
     convention_numbers: dict[str, frozenset[float]]  # unit -> values the conventions use
     conventions: tuple[_Convention, ...]
     coordinates: frozenset[str]  # skills whose numbers are positions, not amounts
     skill_words: frozenset[str]  # keywords, aliases and direction words: never an object's name
     part_nouns: frozenset[str]  # the nouns of the robot's description ("head", "camera")
     opposites: dict[str, str]  # skill keyword -> its opposite, both ways
-    direction_words: frozenset[str]  # the words of `directions`, every pair's
 
 
 @dataclass(frozen=True)
@@ -219,6 +218,13 @@ def _build_vocabulary(profile: Profile) -> _Vocabulary:
     direction_words = {w for d in directions for w in (*d[1], *d[3])}
     part_words = {p: frozenset(w for w in ws if counted[w] == 1 and "_" not in w and w not in direction_words)
                   for p, ws in words.items()}
+    # "pan left then right" says the head's ways in the words the base's turns are told apart by. The
+    # keyword itself is no way: "look" would be said of both, as its inflections' prefix.
+    ways = []
+    for skill_keyword, mine_words, opposite_keyword, theirs_words in directions:
+        mine_raw, theirs_raw = _difference(skill_keyword, opposite_keyword)
+        ways.append((skill_keyword, frozenset({mine_raw} & direction_words) or mine_words,
+                     opposite_keyword, frozenset({theirs_raw} & direction_words) or theirs_words))
 
     coordinates = frozenset(s.keyword for s in profile.skills if any(p.is_coordinate for p in s.params))
     numbers: dict[str, set[float]] = {}
@@ -245,13 +251,12 @@ def _build_vocabulary(profile: Profile) -> _Vocabulary:
             skills=frozenset(c.skill for c in plan or ()), whole=whole))
     opposites = {s.keyword: s.opposite for s in profile.skills if s.opposite}
     opposites.update({o: k for k, o in list(opposites.items())})
-    return _Vocabulary(parts=parts, part_words=part_words, directions=tuple(directions),
+    return _Vocabulary(parts=parts, part_words=part_words, directions=tuple(ways),
                        convention_numbers={u: frozenset(v) for u, v in numbers.items()},
                        conventions=tuple(conventions), coordinates=coordinates,
                        skill_words=frozenset({w for ws in words.values() for w in ws} - set(nouns)
                                              | direction_words),
-                       part_nouns=frozenset(nouns), opposites=opposites,
-                       direction_words=frozenset(direction_words))
+                       part_nouns=frozenset(nouns), opposites=opposites)
 
 
 _VOCABULARIES: dict[tuple[str, str], _Vocabulary] = {}
@@ -319,22 +324,18 @@ def _directions(plan: Plan, vocab: _Vocabulary, words: set[str], named: list[_Co
     allowed = {skill for c in named for skill in c.skills}
     doubts = []
     for skill, mine, opposite, theirs in vocab.directions:
-        # "pan left then right" says the head's ways in the words the base's turns are told apart by. The
-        # keyword itself is no way: "look" would be said of both, as its inflections' prefix.
-        ways = [frozenset({raw} & vocab.direction_words) or said_words
-                for said_words, raw in zip((mine, theirs), _difference(skill, opposite), strict=True)]
-        for said_words, unsaid_words, wrong in ((ways[0], ways[1], opposite), (ways[1], ways[0], skill)):
+        for said_words, unsaid_words, wrong in ((mine, theirs, opposite), (theirs, mine, skill)):
             if _said(words, said_words) and not _said(words, unsaid_words):
                 hit = next((c for c in plan if c.skill == wrong), None)
                 if hit is not None:
                     doubts.append(Doubt("direction", f"you said {min(said_words)}, but the plan goes the "
                                                      f"other way ({say(hit, profile)})"))
         both = [c for c in plan if c.skill in (skill, opposite) and c.skill not in allowed]
-        if {c.skill for c in both} == {skill, opposite} and not all(_said(words, way) for way in ways):
+        if {c.skill for c in both} == {skill, opposite} and not (_said(words, mine) and _said(words, theirs)):
             back = next(c for c in both if c.skill != both[0].skill)
             doubts.append(Doubt("direction", f"the plan goes both ways ({say(both[0], profile)}, then "
                                              f"{say(back, profile)}), but you did not say both "
-                                             f"{min(ways[0], key=len)} and {min(ways[1], key=len)}"))
+                                             f"{min(mine, key=len)} and {min(theirs, key=len)}"))
     return doubts
 
 

@@ -68,6 +68,6 @@ def test_clauses_split_on_actions_not_on_coordinates(profile: Profile) -> None:
 
 
 def test_it_never_stands_for_a_place_or_amount(profile: Profile) -> None:
-    # The splitter reads "it" with the translator's own list of words that name no thing.
+    # The splitter reads "it" with the shared list of words that name no thing (names.NOT_NAMES).
     clauses = split_clauses("go over to the spot, then look at it", profile)
     assert [c.text for c in clauses] == ["go over to the spot", "look at it"]
