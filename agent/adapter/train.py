@@ -29,6 +29,10 @@ TOKENIZER_SAMPLE = 200  # training pairs whose prompt and answer must tokenize a
 _BF16_FLAGS = frozenset({"amx_bf16", "avx512_bf16", "bf16"})
 
 
+def _to_stderr(line: str) -> None:
+    print(line, file=sys.stderr, flush=True)
+
+
 class TrainingError(RuntimeError):
     """Training cannot start or go on; the message says what to do."""
 
@@ -82,10 +86,10 @@ def require_train_extra() -> None:
 
 def load_base(gguf_path: Path) -> tuple[Any, Any]:
     """(tokenizer, trainable float32 model) from a GGUF file."""
-    from transformers import AutoModelForCausalLM, AutoTokenizer
+    from transformers import AutoModelForCausalLM
 
     directory, name = str(gguf_path.parent), gguf_path.name
-    tokenizer = AutoTokenizer.from_pretrained(directory, gguf_file=name)
+    tokenizer = load_tokenizer(gguf_path)
     loaded = AutoModelForCausalLM.from_pretrained(directory, gguf_file=name, dtype="float32")
     # A GGUF-loaded model refuses some operations (save_pretrained); a model
     # rebuilt from its config with the weights copied over behaves normally.
@@ -97,6 +101,13 @@ def load_base(gguf_path: Path) -> tuple[Any, Any]:
                             f"missing {real_missing[:3]}, unexpected {unexpected[:3]}")
     model.tie_weights()
     return tokenizer, model
+
+
+def load_tokenizer(gguf_path: Path) -> Any:
+    """The tokenizer transformers builds from a GGUF file (check it with `check_tokenizer` before use)."""
+    from transformers import AutoTokenizer
+
+    return AutoTokenizer.from_pretrained(str(gguf_path.parent), gguf_file=gguf_path.name)
 
 
 def encode(tokenizer: Any, pairs: Sequence[Pair]) -> list[tuple[list[int], list[int]]]:
@@ -164,9 +175,25 @@ def batches(examples: list[tuple[list[int], list[int]]], batch: int, steps: int,
 
 def train(pairs: Sequence[Pair], base_gguf: Path, out: Path, recipe: Recipe, *,
           metadata: dict[str, str] | None = None,
-          progress: Callable[[str], None] = lambda line: print(line, file=sys.stderr, flush=True)
-          ) -> TrainResult:
+          progress: Callable[[str], None] = _to_stderr) -> TrainResult:
     """Train a LoRA adapter on `pairs` and write it to `out` as a llama.cpp LoRA GGUF."""
+    def examples_for(tokenizer: Any) -> list[tuple[list[int], list[int]]]:
+        check_tokenizer(tokenizer, base_gguf, pairs[:TOKENIZER_SAMPLE])
+        return encode(tokenizer, pairs)
+    return _fit(examples_for, base_gguf, out, recipe, metadata, progress)
+
+
+def train_encoded(examples: Sequence[tuple[Sequence[int], Sequence[int]]], base_gguf: Path, out: Path,
+                  recipe: Recipe, *, metadata: dict[str, str] | None = None,
+                  progress: Callable[[str], None] = _to_stderr) -> TrainResult:
+    """Train as `train` does, from pairs encoded already where the tokenizer agreed with llama.cpp
+    (`agent.adapter.examples`), so this machine's tokenizer is never used."""
+    encoded = [(list(ids), list(labels)) for ids, labels in examples]
+    return _fit(lambda _tokenizer: encoded, base_gguf, out, recipe, metadata, progress)
+
+
+def _fit(examples_for: Callable[[Any], list[tuple[list[int], list[int]]]], base_gguf: Path, out: Path,
+         recipe: Recipe, metadata: dict[str, str] | None, progress: Callable[[str], None]) -> TrainResult:
     require_train_extra()
     import torch
 
@@ -179,8 +206,7 @@ def train(pairs: Sequence[Pair], base_gguf: Path, out: Path, recipe: Recipe, *,
     progress(f"loading base model {base_gguf.name} ...")
     tokenizer, model, bf16 = lora_model(base_gguf, recipe, device)
     progress(f"the frozen base runs in {'bfloat16' if bf16 else 'float32'} on {device}")
-    check_tokenizer(tokenizer, base_gguf, pairs[:TOKENIZER_SAMPLE])
-    examples = encode(tokenizer, pairs)
+    examples = examples_for(tokenizer)
     if not examples:
         raise TrainingError("no training pair fits in the token budget; generate more or shorter pairs")
     plan = batches(examples, recipe.batch, recipe.steps, random.Random(recipe.seed))

@@ -10,9 +10,12 @@ import platform
 import sys
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from agent.adapter.recipe import Recipe
+
+if TYPE_CHECKING:
+    from agent.adapter.data import Pair
 
 EXIT_USAGE = 2
 DEFAULTS = Recipe()
@@ -58,6 +61,15 @@ def register(subparsers: Any) -> None:
                         help="also write the adapter every N steps as OUT.stepN.gguf, for a learning curve "
                              "(default 0: never)")
     parser.add_argument("--dump-data", metavar="FILE", help="also write the training pairs here as JSON lines")
+    moved = parser.add_mutually_exclusive_group()
+    moved.add_argument("--save-examples", metavar="FILE",
+                       help="generate and encode the training pairs, write them to FILE (gzipped JSON) and stop; "
+                            "for training on another machine, such as a GPU one whose transformers splits "
+                            "text unlike llama.cpp")
+    moved.add_argument("--examples", metavar="FILE",
+                       help="train from pairs encoded by --save-examples (same --profile and --model) instead "
+                            "of generating them; --pairs is then the file's, and --seed sets the order and "
+                            "the weights only")
     parser.set_defaults(func=_train)
 
 
@@ -74,11 +86,16 @@ def _train(args: argparse.Namespace) -> int:
     if args.threads < 0:
         print("nrtrans train-adapter: error: --threads must be 0 (automatic) or more", file=sys.stderr)
         return EXIT_USAGE
+    if args.examples and args.dump_data:
+        print("nrtrans train-adapter: error: --dump-data writes generated pairs, and --examples generates none; "
+              "dump them where the examples were saved", file=sys.stderr)
+        return EXIT_USAGE
     from agent.adapter.card import AdapterCard, card_path, sha256_of
     from agent.adapter.data import generate
+    from agent.adapter.examples import EncodedExamples, read_examples
     from agent.adapter.hygiene import eval_tasks, held_out_filter
     from agent.adapter.prompt import DEFAULT_ADAPTER, PROMPT_VERSION
-    from agent.adapter.train import TrainingError, require_train_extra, train
+    from agent.adapter.train import TrainingError, require_train_extra, train, train_encoded
     from agent.translate import ModelNotFoundError
     from agent.translate.model_path import resolve_model
     from rsl.profile import ProfileError, load_profile
@@ -95,11 +112,20 @@ def _train(args: argparse.Namespace) -> int:
     started = time.monotonic()
     suite = eval_tasks()
     excluded_by_suite = held_out_filter(suite)
-    print(f"generating {args.pairs} training pairs from profile {profile.name!r} "
-          f"(keeping {len(suite)} eval-suite tasks and their paraphrases out) ...", file=sys.stderr)
+    base_sha = sha256_of(base)
+    encoded: EncodedExamples | None = None
+    pairs: list[Pair] = []
     try:
-        pairs = generate(profile, args.pairs, seed=args.seed, exclude=excluded_by_suite)
-        seen = {p.normalized for p in pairs}
+        if args.examples:
+            encoded = read_examples(Path(args.examples))
+            encoded.check_fits(base_sha, profile.digest, PROMPT_VERSION)
+            print(f"training on {len(encoded.examples)} pairs encoded in {args.examples}", file=sys.stderr)
+            seen = set(encoded.normalized)
+        else:
+            print(f"generating {args.pairs} training pairs from profile {profile.name!r} "
+                  f"(keeping {len(suite)} eval-suite tasks and their paraphrases out) ...", file=sys.stderr)
+            pairs = generate(profile, args.pairs, seed=args.seed, exclude=excluded_by_suite)
+            seen = {p.normalized for p in pairs}
         held_out = generate(profile, args.eval_pairs, seed=args.seed + 1_000_003,
                             exclude=lambda text: text in seen or excluded_by_suite(text)) if args.eval_pairs else []
     except (ValueError, RuntimeError) as exc:
@@ -109,35 +135,44 @@ def _train(args: argparse.Namespace) -> int:
             for pair in pairs:
                 handle.write(json.dumps({"task": pair.task, "normalized": pair.normalized, "prompt": pair.prompt,
                                          "program": pair.program, "group": pair.group}) + "\n")
+    if args.save_examples:
+        return _save_examples(Path(args.save_examples), pairs, base, base_sha, profile, args.seed)
 
     threads = args.threads or _auto_threads()
     print(f"training with {threads} CPU thread(s)", file=sys.stderr)
 
-    recipe = dataclasses.replace(DEFAULTS, pairs=args.pairs, steps=args.steps, batch=args.batch,
-                                 learning_rate=args.lr, rank=args.rank, alpha=2.0 * args.rank, seed=args.seed,
-                                 threads=threads, checkpoint_every=args.checkpoint_every)
-    base_sha = sha256_of(base)
+    recipe = dataclasses.replace(DEFAULTS, pairs=encoded.pairs if encoded else args.pairs, steps=args.steps,
+                                 batch=args.batch, learning_rate=args.lr, rank=args.rank, alpha=2.0 * args.rank,
+                                 seed=args.seed, threads=threads, checkpoint_every=args.checkpoint_every)
+    metadata = {"base_model_sha256": base_sha, "profile_sha256": profile.digest,
+                "prompt_version": str(PROMPT_VERSION)}
     try:
-        result = train(pairs, base, out, recipe, metadata={
-            "base_model_sha256": base_sha, "profile_sha256": profile.digest,
-            "prompt_version": str(PROMPT_VERSION)})
+        if encoded is not None:
+            result = train_encoded(encoded.examples, base, out, recipe, metadata=metadata)
+        else:
+            result = train(pairs, base, out, recipe, metadata=metadata)
     except TrainingError as exc:
         return _fail(str(exc))
 
     import torch
     import transformers
 
-    groups: dict[str, int] = {}
-    for pair in pairs:
-        groups[pair.group] = groups.get(pair.group, 0) + 1
+    if encoded is not None:
+        data = {"pairs": encoded.pairs, "encoded": result.examples, "seed": encoded.seed,
+                "groups": encoded.groups, "encoded_with_transformers": encoded.transformers}
+    else:
+        groups: dict[str, int] = {}
+        for pair in pairs:
+            groups[pair.group] = groups.get(pair.group, 0) + 1
+        data = {"pairs": len(pairs), "encoded": result.examples, "seed": args.seed, "groups": groups}
     card = AdapterCard(
         adapter_file=out.name, adapter_sha256=sha256_of(out), base_model_file=base.name,
         base_model_sha256=base_sha, profile_name=profile.name, profile_sha256=profile.digest,
         prompt_version=PROMPT_VERSION,
-        data={"pairs": len(pairs), "encoded": result.examples, "seed": args.seed, "groups": groups,
-              "held_out_pairs": len(held_out), "eval_suite_tasks_excluded": len(suite)},
-        training={"steps": result.steps, "batch": recipe.batch, "learning_rate": recipe.learning_rate,
-                  "rank": recipe.rank, "alpha": recipe.alpha, "bf16_base": result.bf16,
+        data={**data, "held_out_pairs": len(held_out), "eval_suite_tasks_excluded": len(suite)},
+        training={"seed": args.seed, "steps": result.steps, "batch": recipe.batch,
+                  "learning_rate": recipe.learning_rate, "rank": recipe.rank, "alpha": recipe.alpha,
+                  "bf16_base": result.bf16,
                   "first_loss": round(result.first_loss, 4), "final_loss": round(result.final_loss, 4),
                   "loss_every_50": [round(x, 4) for x in result.losses[::50]],
                   "train_seconds": round(result.seconds, 1),
@@ -152,6 +187,33 @@ def _train(args: argparse.Namespace) -> int:
     print(f"wrote {out} and {card_path(out)}", file=sys.stderr)
     if card.eval:
         print(json.dumps(card.eval, indent=2))
+    return 0
+
+
+def _save_examples(path: Path, pairs: list[Pair], base: Path, base_sha: str, profile: Any, seed: int) -> int:
+    """Encode `pairs` with this machine's tokenizer, checked against llama.cpp's, and write them to `path`."""
+    import transformers
+
+    from agent.adapter.examples import EncodedExamples
+    from agent.adapter.prompt import PROMPT_VERSION
+    from agent.adapter.train import TOKENIZER_SAMPLE, TrainingError, check_tokenizer, encode, load_tokenizer
+
+    print(f"encoding {len(pairs)} pairs with the tokenizer of {base.name} ...", file=sys.stderr)
+    tokenizer = load_tokenizer(base)
+    try:
+        check_tokenizer(tokenizer, base, pairs[:TOKENIZER_SAMPLE])
+    except TrainingError as exc:
+        return _fail(str(exc))
+    groups: dict[str, int] = {}
+    for pair in pairs:
+        groups[pair.group] = groups.get(pair.group, 0) + 1
+    examples = tuple((tuple(ids), tuple(labels)) for ids, labels in encode(tokenizer, pairs))
+    EncodedExamples(examples=examples, base_model_sha256=base_sha, profile_name=profile.name,
+                    profile_sha256=profile.digest, prompt_version=PROMPT_VERSION, seed=seed, pairs=len(pairs),
+                    groups=groups, normalized=tuple(p.normalized for p in pairs),
+                    transformers=transformers.__version__).write(path)
+    print(f"wrote {len(examples)} encoded pairs to {path}. Train from them on any machine with nrtrans[train] "
+          f"and the same base model:\n  nrtrans train-adapter --examples {path}", file=sys.stderr)
     return 0
 
 

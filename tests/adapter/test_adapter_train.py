@@ -85,3 +85,69 @@ def test_training_refuses_a_tokenizer_that_splits_text_unlike_llama_cpp(profile:
     message = str(refused.value)
     assert "llama.cpp" in message and "transformers" in message
     assert pairs[0].prompt.splitlines()[0][:20] in message  # where: the text that tokenized differently
+
+
+def test_pairs_encoded_here_train_an_adapter_through_the_examples_file(profile: Profile, base_gguf: Path,
+                                                                       tmp_path: Path) -> None:
+    # A GPU machine's transformers may split text unlike llama.cpp: it trains from IDs encoded here.
+    requires("torch", "transformers", "peft", "gguf")
+    import llama_cpp
+
+    from agent.adapter.examples import read_examples
+    from agent.adapter.hygiene import eval_tasks, held_out_filter
+    from agent.adapter.prompt import training_text
+    from agent.cli import main
+
+    saved = tmp_path / "examples.json.gz"
+    assert main(["train-adapter", "--pairs", "6", "--seed", "4", "--eval", "0", "--save-examples", str(saved)]) == 0
+    encoded = read_examples(saved)
+    pairs = generate(profile, 6, seed=4, exclude=held_out_filter(eval_tasks()))
+    # Each pair as llama.cpp tokenizes it at run time, with the loss on the answer only.
+    vocab = llama_cpp.Llama(str(base_gguf), vocab_only=True, verbose=False)
+    expected = []
+    for pair in pairs:
+        prompt, answer = (vocab.tokenize(text.encode(), add_bos=False, special=False)
+                          for text in training_text(pair.prompt, pair.program))
+        prompt = [vocab.token_bos(), *prompt]
+        answer = [*answer, vocab.token_eos()]
+        expected.append((tuple(prompt + answer), tuple([-100] * len(prompt) + answer)))
+    assert list(encoded.examples) == expected
+    assert encoded.normalized == tuple(p.normalized for p in pairs) and encoded.seed == 4
+    assert sum(encoded.groups.values()) == encoded.pairs == 6
+
+    out = tmp_path / "moved.gguf"
+    assert main(["train-adapter", "--examples", str(saved), "--steps", "2", "--batch", "2", "--rank", "2",
+                 "--eval", "0", "--threads", "1", "--out", str(out)]) == 0
+    card = read_card(out.with_suffix(".json"))
+    assert card.data["pairs"] == 6 and card.data["seed"] == 4 and card.data["encoded"] == len(encoded.examples)
+    assert card.data["encoded_with_transformers"] == encoded.transformers
+    assert card.training["steps"] == 2 and out.stat().st_size > 0
+
+
+def test_an_examples_file_for_another_profile_or_a_damaged_one_is_refused(tmp_path: Path,
+                                                                          capsys: pytest.CaptureFixture[str]) -> None:
+    import dataclasses
+
+    from agent.adapter.card import sha256_of
+    from agent.adapter.examples import EncodedExamples
+    from agent.adapter.prompt import PROMPT_VERSION
+    from agent.cli import main
+    from agent.translate.model_path import resolve_model
+    from rsl.profile import load_profile
+
+    requires("torch", "transformers", "peft", "gguf")
+    fits = EncodedExamples(examples=(((2, 5), (-100, 5)),), base_model_sha256=sha256_of(resolve_model(None)),
+                           profile_name="default", profile_sha256=load_profile().digest,
+                           prompt_version=PROMPT_VERSION, seed=0, pairs=1, groups={"simple": 1},
+                           normalized=("drive forward",), transformers="5.24.0")
+    other = dataclasses.replace(fits, profile_sha256="0" * 64).write(tmp_path / "other.json.gz")
+    assert main(["train-adapter", "--examples", str(other), "--eval", "0"]) == 1
+    assert "another robot profile" in capsys.readouterr().err
+
+    damaged = tmp_path / "damaged.json.gz"
+    damaged.write_bytes(fits.write(tmp_path / "fits.json.gz").read_bytes()[:40])
+    assert main(["train-adapter", "--examples", str(damaged), "--eval", "0"]) == 1
+    assert "cannot read encoded examples" in capsys.readouterr().err
+
+    assert main(["train-adapter", "--examples", str(other), "--dump-data", str(tmp_path / "d.jsonl")]) == 2
+    assert not (tmp_path / "d.jsonl").exists()
