@@ -11,32 +11,9 @@ from agent.adapter.card import read_card
 from agent.adapter.data import generate
 from agent.adapter.evaluate import complete, load
 from agent.adapter.recipe import Recipe
-from agent.adapter.train import TrainingError, check_tokenizer, native_bf16, train
+from agent.adapter.train import TrainingError, check_tokenizer, native_bf16, train_encoded
 from rsl.profile import Profile
 from tests.adapter.conftest import requires
-
-
-def test_a_few_steps_lower_the_loss_and_change_llama_cpp_output(profile: Profile, base_gguf: Path,
-                                                                 tmp_path: Path) -> None:
-    requires("torch", "transformers", "peft", "gguf")
-    pairs = generate(profile, 16, seed=5)
-    out = tmp_path / "tiny.gguf"
-    lines: list[str] = []
-    result = train(pairs, base_gguf, out, Recipe(steps=12, batch=4, learning_rate=1e-3, warmup=2, rank=4,
-                                                alpha=8, seed=1, threads=1), progress=lines.append)
-    assert result.steps == 12 and result.examples == 16
-    # 16 pairs in batches of 4: steps 1-4 and 9-12 see the same pairs, before and after learning them.
-    first_epoch, last_epoch = result.losses[:4], result.losses[-4:]
-    assert sum(last_epoch) < 0.6 * sum(first_epoch), result.losses
-    assert any(line.startswith("step 12/12") and "loss" in line for line in lines)
-    assert f"runs in {'bfloat16' if result.bf16 else 'float32'}" in "\n".join(lines)
-    assert result.bf16 == native_bf16(result.device)
-    assert out.stat().st_size > 0
-
-    prompt = pairs[0].prompt
-    plain = complete(load(base_gguf, None, threads=1), prompt, max_tokens=12)
-    adapted = complete(load(base_gguf, out, threads=1), prompt, max_tokens=12)
-    assert adapted != plain
 
 
 def test_cli_refuses_bad_numbers_and_reads_a_card(tmp_path: Path) -> None:
@@ -87,9 +64,10 @@ def test_training_refuses_a_tokenizer_that_splits_text_unlike_llama_cpp(profile:
     assert pairs[0].prompt.splitlines()[0][:20] in message  # where: the text that tokenized differently
 
 
-def test_pairs_encoded_here_train_an_adapter_through_the_examples_file(profile: Profile, base_gguf: Path,
-                                                                       tmp_path: Path) -> None:
-    # A GPU machine's transformers may split text unlike llama.cpp: it trains from IDs encoded here.
+def test_pairs_encoded_here_train_an_adapter_that_learns_them(profile: Profile, base_gguf: Path,
+                                                              tmp_path: Path) -> None:
+    # Encoded by the CLI and trained from the IDs, as on a GPU machine whose transformers splits text
+    # unlike llama.cpp; `train` runs the same steps after encoding the pairs itself.
     requires("torch", "transformers", "peft", "gguf")
     import llama_cpp
 
@@ -99,29 +77,40 @@ def test_pairs_encoded_here_train_an_adapter_through_the_examples_file(profile: 
     from agent.cli import main
 
     saved = tmp_path / "examples.json.gz"
-    assert main(["train-adapter", "--pairs", "6", "--seed", "4", "--eval", "0", "--save-examples", str(saved)]) == 0
+    assert main(["train-adapter", "--pairs", "16", "--seed", "5", "--eval", "0", "--save-examples", str(saved)]) == 0
     encoded = read_examples(saved)
-    pairs = generate(profile, 6, seed=4, exclude=held_out_filter(eval_tasks()))
+    pairs = generate(profile, 16, seed=5, exclude=held_out_filter(eval_tasks()))
     # Each pair as llama.cpp tokenizes it at run time, with the loss on the answer only.
     vocab = llama_cpp.Llama(str(base_gguf), vocab_only=True, verbose=False)
     expected = []
     for pair in pairs:
-        prompt, answer = (vocab.tokenize(text.encode(), add_bos=False, special=False)
-                          for text in training_text(pair.prompt, pair.program))
-        prompt = [vocab.token_bos(), *prompt]
-        answer = [*answer, vocab.token_eos()]
-        expected.append((tuple(prompt + answer), tuple([-100] * len(prompt) + answer)))
+        prompt_ids, answer_ids = (vocab.tokenize(text.encode(), add_bos=False, special=False)
+                                  for text in training_text(pair.prompt, pair.program))
+        prompt_ids = [vocab.token_bos(), *prompt_ids]
+        answer_ids = [*answer_ids, vocab.token_eos()]
+        expected.append((tuple(prompt_ids + answer_ids), tuple([-100] * len(prompt_ids) + answer_ids)))
     assert list(encoded.examples) == expected
-    assert encoded.normalized == tuple(p.normalized for p in pairs) and encoded.seed == 4
-    assert sum(encoded.groups.values()) == encoded.pairs == 6
+    assert encoded.normalized == tuple(p.normalized for p in pairs) and encoded.seed == 5
+    assert sum(encoded.groups.values()) == encoded.pairs == 16
 
-    out = tmp_path / "moved.gguf"
-    assert main(["train-adapter", "--examples", str(saved), "--steps", "2", "--batch", "2", "--rank", "2",
-                 "--eval", "0", "--threads", "1", "--out", str(out)]) == 0
-    card = read_card(out.with_suffix(".json"))
-    assert card.data["pairs"] == 6 and card.data["seed"] == 4 and card.data["encoded"] == len(encoded.examples)
-    assert card.data["encoded_with_transformers"] == encoded.transformers
-    assert card.training["steps"] == 2 and out.stat().st_size > 0
+    out = tmp_path / "tiny.gguf"
+    lines: list[str] = []
+    result = train_encoded(encoded.examples, base_gguf, out,
+                           Recipe(steps=12, batch=4, learning_rate=1e-3, warmup=2, rank=4, alpha=8, seed=1,
+                                  threads=1), progress=lines.append)
+    assert result.steps == 12 and result.examples == 16
+    # 16 pairs in batches of 4: steps 1-4 and 9-12 see the same pairs, before and after learning them.
+    first_epoch, last_epoch = result.losses[:4], result.losses[-4:]
+    assert sum(last_epoch) < 0.6 * sum(first_epoch), result.losses
+    assert any(line.startswith("step 12/12") and "loss" in line for line in lines)
+    assert f"runs in {'bfloat16' if result.bf16 else 'float32'}" in "\n".join(lines)
+    assert result.bf16 == native_bf16(result.device)
+    assert out.stat().st_size > 0
+
+    prompt = pairs[0].prompt
+    plain = complete(load(base_gguf, None, threads=1), prompt, max_tokens=12)
+    adapted = complete(load(base_gguf, out, threads=1), prompt, max_tokens=12)
+    assert adapted != plain
 
 
 def test_an_examples_file_for_another_profile_or_a_damaged_one_is_refused(tmp_path: Path,
