@@ -130,6 +130,12 @@ def encode(tokenizer: Any, pairs: Sequence[Pair]) -> list[tuple[list[int], list[
     return out
 
 
+def encode_checked(tokenizer: Any, base_gguf: Path, pairs: Sequence[Pair]) -> list[tuple[list[int], list[int]]]:
+    """`encode`, after `check_tokenizer` has found the tokenizer splitting text as llama.cpp does."""
+    check_tokenizer(tokenizer, base_gguf, pairs[:TOKENIZER_SAMPLE])
+    return encode(tokenizer, pairs)
+
+
 def check_tokenizer(tokenizer: Any, base_gguf: Path, pairs: Sequence[Pair]) -> None:
     """Refuse to train when the tokenizer transformers builds from the GGUF splits text unlike llama.cpp.
 
@@ -177,10 +183,8 @@ def train(pairs: Sequence[Pair], base_gguf: Path, out: Path, recipe: Recipe, *,
           metadata: dict[str, str] | None = None,
           progress: Callable[[str], None] = _to_stderr) -> TrainResult:
     """Train a LoRA adapter on `pairs` and write it to `out` as a llama.cpp LoRA GGUF."""
-    def examples_for(tokenizer: Any) -> list[tuple[list[int], list[int]]]:
-        check_tokenizer(tokenizer, base_gguf, pairs[:TOKENIZER_SAMPLE])
-        return encode(tokenizer, pairs)
-    return _fit(examples_for, base_gguf, out, recipe, metadata, progress)
+    return _fit(lambda tokenizer: encode_checked(tokenizer, base_gguf, pairs), base_gguf, out, recipe, metadata,
+                progress)
 
 
 def train_encoded(examples: Sequence[tuple[Sequence[int], Sequence[int]]], base_gguf: Path, out: Path,

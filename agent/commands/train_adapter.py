@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import collections
 import dataclasses
 import json
 import os
@@ -127,7 +128,8 @@ def _train(args: argparse.Namespace) -> int:
             pairs = generate(profile, args.pairs, seed=args.seed, exclude=excluded_by_suite)
             seen = {p.normalized for p in pairs}
         held_out = generate(profile, args.eval_pairs, seed=args.seed + 1_000_003,
-                            exclude=lambda text: text in seen or excluded_by_suite(text)) if args.eval_pairs else []
+                            exclude=lambda text: text in seen or excluded_by_suite(text)) \
+            if args.eval_pairs and not args.save_examples else []
     except (ValueError, RuntimeError) as exc:
         return _fail(str(exc))
     if args.dump_data:
@@ -161,10 +163,7 @@ def _train(args: argparse.Namespace) -> int:
         data = {"pairs": encoded.pairs, "encoded": result.examples, "seed": encoded.seed,
                 "groups": encoded.groups, "encoded_with_transformers": encoded.transformers}
     else:
-        groups: dict[str, int] = {}
-        for pair in pairs:
-            groups[pair.group] = groups.get(pair.group, 0) + 1
-        data = {"pairs": len(pairs), "encoded": result.examples, "seed": args.seed, "groups": groups}
+        data = {"pairs": len(pairs), "encoded": result.examples, "seed": args.seed, "groups": _groups(pairs)}
     card = AdapterCard(
         adapter_file=out.name, adapter_sha256=sha256_of(out), base_model_file=base.name,
         base_model_sha256=base_sha, profile_name=profile.name, profile_sha256=profile.digest,
@@ -196,25 +195,26 @@ def _save_examples(path: Path, pairs: list[Pair], base: Path, base_sha: str, pro
 
     from agent.adapter.examples import EncodedExamples
     from agent.adapter.prompt import PROMPT_VERSION
-    from agent.adapter.train import TOKENIZER_SAMPLE, TrainingError, check_tokenizer, encode, load_tokenizer
+    from agent.adapter.train import TrainingError, encode_checked, load_tokenizer
 
     print(f"encoding {len(pairs)} pairs with the tokenizer of {base.name} ...", file=sys.stderr)
-    tokenizer = load_tokenizer(base)
     try:
-        check_tokenizer(tokenizer, base, pairs[:TOKENIZER_SAMPLE])
+        encoded = encode_checked(load_tokenizer(base), base, pairs)
     except TrainingError as exc:
         return _fail(str(exc))
-    groups: dict[str, int] = {}
-    for pair in pairs:
-        groups[pair.group] = groups.get(pair.group, 0) + 1
-    examples = tuple((tuple(ids), tuple(labels)) for ids, labels in encode(tokenizer, pairs))
+    examples = tuple((tuple(ids), tuple(labels)) for ids, labels in encoded)
     EncodedExamples(examples=examples, base_model_sha256=base_sha, profile_name=profile.name,
                     profile_sha256=profile.digest, prompt_version=PROMPT_VERSION, seed=seed, pairs=len(pairs),
-                    groups=groups, normalized=tuple(p.normalized for p in pairs),
+                    groups=_groups(pairs), normalized=tuple(p.normalized for p in pairs),
                     transformers=transformers.__version__).write(path)
     print(f"wrote {len(examples)} encoded pairs to {path}. Train from them on any machine with nrtrans[train] "
           f"and the same base model:\n  nrtrans train-adapter --examples {path}", file=sys.stderr)
     return 0
+
+
+def _groups(pairs: list[Pair]) -> dict[str, int]:
+    """Pairs per group, in the order the groups first appear."""
+    return dict(collections.Counter(pair.group for pair in pairs))
 
 
 def _auto_threads() -> int:
