@@ -54,9 +54,19 @@ _AGAIN = re.compile(rf"\b(?:{'|'.join(_AGAIN_WORDS)}|repeat\w*|twice)\b")
 _SEQUENCE_WORDS = frozenset({"and", "then", "after", "next", "finally", "times", *_AGAIN_WORDS})
 # What negates what follows it up to the end of its clause ("don't move, just look left"), and a part
 # kept still ("keep your head still and turn left", "keep your head where it is"). "why don't you look up"
-# suggests, not negates.
-_NEGATION = re.compile(r"(?<!\bwhy )\b(?:don'?t|do not|never|without|no|not)\b[^,.;]*"
+# suggests, and "don't forget to look up" asks, rather than negates.
+_NEGATION = re.compile(r"(?<!\bwhy )\b(?:don'?t|do not|never|without|no|not)\b(?! forget\b)[^,.;]*"
                        r"|\b(?:keep|hold)\s+(?:[a-z]+\s+){0,2}?(?:still|steady|in place|where it is|as it is)\b")
+# Taking a step back: "skip the turn", "forget about turning", "don't turn". It reaches to the end of its
+# clause or to a word that starts another step ("skip the turn and drive on"); "don't forget to look up"
+# asks for the step.
+_CANCELLED = re.compile(r"(?<!\bwhy )\b(?:don'?t|do not|never|without|skip|cancel|scrap|omit|ignore|leave out"
+                        r"|(?<!don't )(?<!dont )(?<!do not )(?<!never )forget)\b(?! forget\b)"
+                        r"(?:(?!\b(?:and|then|but|just|instead|only|so|rather)\b)[^,.;])*")
+# A way said of where a thing is ("the cup on your right") or of when ("right away"), not which way to go.
+_PLACE_OR_TIME = frozenset({"now", "away", "here", "there", "after", "before", "behind", "next", "of", "in", "at",
+                            "on", "beside", "by"})
+_OWNER = frozenset({"the", "your", "my", "its", "his", "her", "their", "all"})
 # A question about the robot, asked and left there ("why do you keep looking up"), is no request;
 # "why don't you look up" suggests ("don't" is no auxiliary here), and a request after it
 # ("what are you waiting for, go forward") is one.
@@ -90,6 +100,7 @@ class _Vocabulary:
     skill_words: frozenset[str]  # keywords, aliases and direction words: never an object's name
     part_nouns: frozenset[str]  # the nouns of the robot's description ("head", "camera")
     opposites: dict[str, str]  # skill keyword -> its opposite, both ways
+    step_words: dict[str, frozenset[str]]  # skill keyword -> the words that ask for that step
 
 
 @dataclass(frozen=True)
@@ -124,6 +135,8 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     doubts += _repeated_after(text, plan, profile)
     doubts += _restated(text, plan, vocab, profile)
     doubts += _doubled(text, plan, profile)
+    doubts += _ways_gone(affirmed, plan, vocab)
+    doubts += _cancelled(text, plan, vocab, profile)
     doubts += _carried_out(_named(_WORD.findall(affirmed), vocab), text, plan, vocab)
     doubts += _objects(text, plan, known_objects, vocab)
     if _QUESTION.match(text):
@@ -251,12 +264,17 @@ def _build_vocabulary(profile: Profile) -> _Vocabulary:
             skills=frozenset(c.skill for c in plan or ()), whole=whole))
     opposites = {s.keyword: s.opposite for s in profile.skills if s.opposite}
     opposites.update({o: k for k, o in list(opposites.items())})
+    # A way ("right") or a short word ("go", "up") asks for no step of its own.
+    step_words = {s.keyword: frozenset(w for w in (s.keyword, *s.aliases,
+                                                   *_WORD.findall(_FIRST_CLAUSE.split(s.description, 1)[0].lower())[:1])
+                                       if len(w) >= 4 and "_" not in w and w not in direction_words)
+                  for s in profile.skills}
     return _Vocabulary(parts=parts, part_words=part_words, directions=tuple(ways),
                        convention_numbers={u: frozenset(v) for u, v in numbers.items()},
                        conventions=tuple(conventions), coordinates=coordinates,
                        skill_words=frozenset({w for ws in words.values() for w in ws} - set(nouns)
                                              | direction_words),
-                       part_nouns=frozenset(nouns), opposites=opposites)
+                       part_nouns=frozenset(nouns), opposites=opposites, step_words=step_words)
 
 
 _VOCABULARIES: dict[tuple[str, str], _Vocabulary] = {}
@@ -475,6 +493,57 @@ def _doubled(text: str, plan: Plan, profile: Profile) -> list[Doubt]:
         return [Doubt("doubled", f"the plan does the same step twice in a row ({say(a, profile)}), but you "
                                  "did not ask for it twice")]
     return []
+
+
+def _ways_gone(affirmed: str, plan: Plan, vocab: _Vocabulary) -> list[Doubt]:
+    """Every way said of a part the plan moves is a way it goes: "go right 2 m" is no straight drive.
+
+    Only plans whose moving steps all have a way are read: a drive to an
+    object or a point ("come back", "go right to the door") goes whichever
+    way it must.
+    """
+    ways: dict[str, set[str]] = {}
+    for skill, mine, opposite, theirs in vocab.directions:
+        for keyword, said in ((skill, mine), (opposite, theirs)):
+            for way in said:
+                ways.setdefault(way, set()).add(keyword)
+    directed = {k for keywords in ways.values() for k in keywords}
+    moving = [c.skill for c in plan if c.skill in directed or vocab.parts.get(c.skill) == WHOLE]
+    if not moving or any(skill not in directed for skill in moving):
+        return []
+    moved = {vocab.parts.get(skill) for skill in moving}
+    planned = {c.skill for c in plan}
+    tokens = ["", *_WORD.findall(affirmed), ""]
+    doubts = []
+    for before, token, after in zip(tokens, tokens[1:], tokens[2:], strict=False):
+        # "pick up", "back up": the way is part of a word that names a step.
+        joined = before + token in vocab.skill_words or token + after in vocab.skill_words
+        if token not in ways or joined or after in _PLACE_OR_TIME or before in _OWNER:
+            continue
+        keywords = ways[token]
+        if keywords & planned or not {vocab.parts.get(k) for k in keywords} & moved:
+            continue
+        doubts.append(Doubt("way", f"you said {token}, but the plan never goes {token}"))
+    return list({d.reason: d for d in doubts}.values())
+
+
+def _cancelled(text: str, plan: Plan, vocab: _Vocabulary, profile: Profile) -> list[Doubt]:
+    """A step whose last mention takes it back ("..., actually skip the turn") is not in the plan."""
+    spans = [(m.start(), m.end(), m.group(0).strip()) for m in _CANCELLED.finditer(text)]
+    if not spans:
+        return []
+    mentions = [(m.start(), m.group(0)) for m in _WORD.finditer(text)]
+    doubts = []
+    for command in plan:
+        words = vocab.step_words.get(command.skill, frozenset())
+        last = next((at for at, token in reversed(mentions)
+                     if any(token == w or (token.startswith(w.rstrip("e")) and len(token) <= len(w) + 3)
+                            for w in words)), None)
+        span = next((said for start, end, said in spans if last is not None and start <= last < end), None)
+        if span is not None:
+            doubts.append(Doubt("cancelled", f'you said "{span}", but the plan still does it '
+                                             f"({say(command, profile)})"))
+    return list({d.reason: d for d in doubts}.values())
 
 
 # How many words may stand between a phrase's own ("turn all the way around" names "turn around").

@@ -137,6 +137,15 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
      "you asked a question, not for the robot to act, but the plan acts (drive forward 2 m)"),
     ("have you looked up at the shelf yet", "lookup 0.5236;",
      "you asked a question, not for the robot to act, but the plan acts (look up 30°)"),
+    # A way said that the plan never goes.
+    ("go right two meters", "forward 2;", "you said right, but the plan never goes right"),
+    # A step taken back at its last mention.
+    ("drive forward four metres and turn left, actually skip the turn", "forward 4; turnleft 1.5708;",
+     'you said "skip the turn", but the plan still does it (turn left 90°)'),
+    ("turn left then go forward, wait, forget the turn", "turnleft 1.5708; forward 1;",
+     'you said "forget the turn", but the plan still does it (turn left 90°)'),
+    ("drive forward without turning", "forward 1; turnleft 1.5708;",
+     'you said "without turning", but the plan still does it (turn left 90°)'),
 ])
 def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str, expected: str,
                                                          profile: Profile) -> None:
@@ -214,6 +223,15 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     ("pick up the water bottle please", "grasp water_bottle;"),
     ("pick up the book gently", "grasp book;"),
     ("go to the red cup, then pick up the cup", "approach red_cup; grasp cup;"),
+    # A way said of where a thing is or when, or gone by a drive to a point.
+    ("right away, turn left", "turnleft 1.5708;"),
+    ("turn right and grab the cup on the left", "turnright 1.5708; grasp cup;"),
+    ("turn left and pick the cup up", "turnleft 1.5708; grasp cup;"),
+    ("turn left and come back home", "turnleft 1.5708; goto 0, 0;"),
+    # Forgetting not to is asking; a step taken back is not planned; a thing ignored is no step.
+    ("don't forget to look up after you turn left", "turnleft 1.5708; lookup 0.5236;"),
+    ("skip the turn and just drive two meters", "forward 2;"),
+    ("ignore the cup and turn left", "turnleft 1.5708;"),
 ])
 def test_a_plan_that_does_what_was_said_has_no_doubt(task: str, program: str, profile: Profile) -> None:
     assert reasons(task, program, profile, ["cup", "table", "keys"]) == []
