@@ -283,18 +283,31 @@ def _convert_numbers(tokens: list[str]) -> list[str]:
     i = 0
     while i < len(tokens):
         token = tokens[i]
-        # "the point 2, 5" names a place; "point 2" after no article is a decimal.
-        converted = None if token == "point" and out[-1:] in (["the"], ["a"]) else _convert_at(tokens, i)
+        # "the point 2, 5" and "to point 3 comma minus 2" name a place; "point 2" alone is a decimal.
+        place = token == "point" and (out[-1:] in (["the"], ["a"]) or _coordinates_at(tokens, i + 1) is not None)
+        converted = None if place else _convert_at(tokens, i)
         if converted is not None and converted[1] > i:
             text, i = converted
             out.append(text)
             continue
         if token in ("twice", "thrice"):
             out.append("2 times" if token == "twice" else "3 times")
+        elif token == "comma" and out and _is_number_token(out[-1]) and _parse_number(tokens, i + 1) is not None:
+            # A comma said between two numbers, as a recognizer writes coordinates.
+            out.append(",")
         else:
             out.append(token)
         i += 1
     return out
+
+
+def _coordinates_at(tokens: Sequence[str], i: int) -> int | None:
+    """Where two numbers said as a point ("3 comma minus 2", "two, five") end, or None."""
+    first = _parse_number(tokens, i)
+    if first is None or first[1] >= len(tokens) or tokens[first[1]] not in (",", "comma", "and"):
+        return None
+    second = _parse_number(tokens, first[1] + 1)
+    return None if second is None else second[1]
 
 
 def _u_turn_at(tokens: Sequence[str], i: int) -> int | None:

@@ -18,6 +18,8 @@ import re
 from collections import Counter
 from collections.abc import Collection
 
+from agent.corrections import MARKERS
+
 # Words that come before a thing's name and are never one ("approach a" from "move to the right a bit").
 DETERMINERS = ("the", "a", "an", "some", "that", "this", "my", "your")
 # Words of English's closed classes (pronouns, prepositions, conjunctions, auxiliaries, a few adverbs
@@ -34,7 +36,9 @@ FUNCTION_WORDS = frozenset({"i", "me", "you", "he", "him", "she", "her", "it", "
                             "only", "already", "still", "even", "first", "last", "back", "away", "instead", "though",
                             "anyway", "all", "both",
                             "each", "every", "any", "other", "another", "same", "such", "one", "ones", "thanks",
-                            "thank", "ok", "okay", "um", "uh", "hmm", "yes", "no", "not"})
+                            "thank", "ok", "okay", "um", "uh", "hmm", "yes", "no", "not"}
+                           # The words of a self-correction ("the red cup, wait, the blue cup").
+                           | {word for marker in MARKERS for word in marker.split()})
 # Nouns of place, amount and shape a task says that are never the object a skill acts on.
 NOT_NAMES = frozenset({"left", "right", "start", "origin", "beginning", "way", "same", "other", "front",
                        "back", "end", "middle", "centre", "center", "robot", "side", "distance", "time", "times",

@@ -43,6 +43,8 @@ def test_a_word_said_on_its_own_as_well_is_not_only_in_a_pair() -> None:
     ("grasp the can", ("grasp", "can")),
     # Other words stay, alone and with their neighbours: the model picks.
     ("pick up the book gently", ("pick", "book", "gently", "book_gently")),
+    # A self-correction's words name nothing.
+    ("pick up the red cup, wait, the blue cup", ("pick", "red_cup", "blue_cup")),
 ])
 def test_a_whole_task_offers_the_words_that_may_name_a_thing(text: str, offered: tuple[str, ...]) -> None:
     assert offered_names(text, not_names={"left", "right"}) == offered

@@ -34,6 +34,10 @@ from agent.normalize import normalize_task
         ("drive to the point -2, 1.5", "drive to the point -2, 1.5"),
         ("drive point five meters", "drive 0.5 m"),
         ("go to the point two, five", "go to the point 2, 5"),
+        # Two numbers after "point" are a place, as a recognizer writes it, comma and all.
+        ("er go to point three comma minus two", "go to point 3, -2"),
+        ("go to two comma three", "go to 2, 3"),
+        ("drive point five meters, and then turn", "drive 0.5 m, and then turn"),
         ("do one complete rotation", "do 6.2832 rad"),
         ("spin a whole turn", "spin 6.2832 rad"),
         # A U-turn is half a turn, as exact as "half a turn".
