@@ -115,6 +115,8 @@ class _Convention:
     default: bool
     skills: frozenset[str]  # the skills of its example program
     whole: bool  # a whole command ("look around"), run as its program, not an amount of another step
+    # Consecutive steps of its program that act on one object (approach X; grasp X).
+    same_object: frozenset[tuple[str, str]]
 
 
 def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collection[str] | None = None
@@ -137,7 +139,10 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     doubts += _doubled(text, plan, profile)
     doubts += _ways_gone(affirmed, plan, vocab)
     doubts += _cancelled(text, plan, vocab, profile)
-    doubts += _carried_out(_named(_WORD.findall(affirmed), vocab), text, plan, vocab)
+    affirmed_named = _named(_WORD.findall(affirmed), vocab)
+    doubts += _carried_out(affirmed_named, text, plan, vocab)
+    doubts += _one_object(named, plan)
+    doubts += _negated_done([c for c in named if c not in affirmed_named], plan, vocab)
     doubts += _objects(text, plan, known_objects, vocab)
     if _QUESTION.match(text):
         doubts.append(Doubt("question", f"you asked a question, not for the robot to act, but the plan acts "
@@ -257,11 +262,13 @@ def _build_vocabulary(profile: Profile) -> _Vocabulary:
         for unit, unit_values in values.items():
             numbers.setdefault(unit, set()).update(unit_values)
         whole = convention.whole_command
+        objects = [(c.skill, tuple(a.name for a in c.args if isinstance(a, ObjectRef))) for c in plan or ()]
+        same_object = frozenset((a, b) for (a, x), (b, y) in itertools.pairwise(objects) if x and x == y)
         conventions.append(_Convention(
             phrase=convention.phrase, words=tuple(_WORD.findall(convention.phrase.lower())),
             meaning=convention.meaning, amounts={u: frozenset(v) for u, v in values.items()},
             default=not whole and convention.phrase not in convention.task,
-            skills=frozenset(c.skill for c in plan or ()), whole=whole))
+            skills=frozenset(c.skill for c in plan or ()), whole=whole, same_object=same_object))
     opposites = {s.keyword: s.opposite for s in profile.skills if s.opposite}
     opposites.update({o: k for k, o in list(opposites.items())})
     # A way ("right") or a short word ("go", "up") asks for no step of its own.
@@ -544,6 +551,36 @@ def _cancelled(text: str, plan: Plan, vocab: _Vocabulary, profile: Profile) -> l
             doubts.append(Doubt("cancelled", f'you said "{span}", but the plan still does it '
                                              f"({say(command, profile)})"))
     return list({d.reason: d for d in doubts}.values())
+
+
+def _one_object(named: list[_Convention], plan: Plan) -> list[Doubt]:
+    """Where a named convention acts on one thing in consecutive steps ("fetch"), the plan does too."""
+    pairs = {pair for c in named for pair in c.same_object}
+    doubts = []
+    for a, b in itertools.pairwise(plan):
+        first = [x.name for x in a.args if isinstance(x, ObjectRef)]
+        second = [x.name for x in b.args if isinstance(x, ObjectRef)]
+        if (a.skill, b.skill) in pairs and first and second and first != second:
+            doubts.append(Doubt("same-object", f"the plan goes for the {first[0].replace('_', ' ')} but then takes "
+                                               f"the {second[0].replace('_', ' ')}"))
+    return doubts
+
+
+def _negated_done(negated: list[_Convention], plan: Plan, vocab: _Vocabulary) -> list[Doubt]:
+    """A convention said only to deny it ("no need to look around") is not carried out."""
+    planned = [(abs(a.value), a.unit) for c in plan if c.skill not in vocab.coordinates
+               for a in c.args if isinstance(a, Quantity)]
+    skills = {c.skill for c in plan}
+    doubts = []
+    for convention in negated:
+        if convention.default:
+            continue
+        amount = any(_close(value, amount) for unit, amounts in convention.amounts.items() for amount in amounts
+                     for value, planned_unit in planned if planned_unit == unit)
+        if (convention.skills <= skills or not convention.whole) and (amount or not convention.amounts):
+            doubts.append(Doubt("negated-convention", f'you said not "{convention.phrase}" '
+                                                      f"({convention.meaning}), but the plan does it"))
+    return doubts
 
 
 # How many words may stand between a phrase's own ("turn all the way around" names "turn around").

@@ -137,6 +137,13 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
      "you asked a question, not for the robot to act, but the plan acts (drive forward 2 m)"),
     ("have you looked up at the shelf yet", "lookup 0.5236;",
      "you asked a question, not for the robot to act, but the plan acts (look up 30°)"),
+    # A convention that acts on one thing does so in the plan; one denied is not done.
+    ("fetch the ball, good dog!", "approach ball; grasp dog; goto 0, 0;",
+     "the plan goes for the ball but then takes the dog"),
+    ("no need to look around, just look at what's in front of you",
+     "perceive; lookleft 1.5708; perceive; lookright 3.1416; perceive; lookleft 1.5708;",
+     'you said not "look around" (pan left 1.5708 rad, perceive, pan right 3.1416 rad, perceive, pan left '
+     '1.5708 rad back to centre), but the plan does it'),
     # A way said that the plan never goes.
     ("go right two meters", "forward 2;", "you said right, but the plan never goes right"),
     # A step taken back at its last mention.
@@ -223,6 +230,9 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     ("pick up the water bottle please", "grasp water_bottle;"),
     ("pick up the book gently", "grasp book;"),
     ("go to the red cup, then pick up the cup", "approach red_cup; grasp cup;"),
+    ("fetch the ball, good dog!", "approach ball; grasp ball; goto 0, 0;"),
+    ("go to the table and pick up the cup", "approach table; grasp cup;"),
+    ("no need to look around, just look at what's in front of you", "perceive;"),
     # A way said of where a thing is or when, or gone by a drive to a point.
     ("right away, turn left", "turnleft 1.5708;"),
     ("turn right and grab the cup on the left", "turnright 1.5708; grasp cup;"),
