@@ -55,12 +55,13 @@ _SEQUENCE_WORDS = frozenset({"and", "then", "after", "next", "finally", "times",
 # What negates what follows it up to the end of its clause ("don't move, just look left"), and a part
 # kept still ("keep your head still and turn left", "keep your head where it is"). "why don't you look up"
 # suggests, and "don't forget to look up" asks, rather than negates.
-_NEGATION = re.compile(r"(?<!\bwhy )\b(?:don'?t|do not|never|without|no|not)\b(?! forget\b)[^,.;]*"
+_NEGATORS = r"don'?t|do not|never|without"
+_NEGATION = re.compile(rf"(?<!\bwhy )\b(?:{_NEGATORS}|no|not)\b(?! forget\b)[^,.;]*"
                        r"|\b(?:keep|hold)\s+(?:[a-z]+\s+){0,2}?(?:still|steady|in place|where it is|as it is)\b")
 # Taking a step back: "skip the turn", "forget about turning", "don't turn". It reaches to the end of its
 # clause or to a word that starts another step ("skip the turn and drive on"); "don't forget to look up"
 # asks for the step.
-_CANCELLED = re.compile(r"(?<!\bwhy )\b(?:don'?t|do not|never|without|skip|cancel|scrap|omit|ignore|leave out"
+_CANCELLED = re.compile(rf"(?<!\bwhy )\b(?:{_NEGATORS}|skip|cancel|scrap|omit|ignore|leave out"
                         r"|(?<!don't )(?<!dont )(?<!do not )(?<!never )forget)\b(?! forget\b)"
                         r"(?:(?!\b(?:and|then|but|just|instead|only|so|rather)\b)[^,.;])*")
 # A way said of where a thing is ("the cup on your right") or of when ("right away"), not which way to go.
@@ -101,6 +102,7 @@ class _Vocabulary:
     part_nouns: frozenset[str]  # the nouns of the robot's description ("head", "camera")
     opposites: dict[str, str]  # skill keyword -> its opposite, both ways
     step_words: dict[str, frozenset[str]]  # skill keyword -> the words that ask for that step
+    way_skills: dict[str, frozenset[str]]  # way ("left") -> the skills that go it (turnleft, lookleft)
 
 
 @dataclass(frozen=True)
@@ -276,12 +278,18 @@ def _build_vocabulary(profile: Profile) -> _Vocabulary:
                                                    *_WORD.findall(_FIRST_CLAUSE.split(s.description, 1)[0].lower())[:1])
                                        if len(w) >= 4 and "_" not in w and w not in direction_words)
                   for s in profile.skills}
+    way_skills: dict[str, set[str]] = {}
+    for skill_keyword, mine_words, opposite_keyword, theirs_words in ways:
+        for keyword, said in ((skill_keyword, mine_words), (opposite_keyword, theirs_words)):
+            for way in said:
+                way_skills.setdefault(way, set()).add(keyword)
     return _Vocabulary(parts=parts, part_words=part_words, directions=tuple(ways),
                        convention_numbers={u: frozenset(v) for u, v in numbers.items()},
                        conventions=tuple(conventions), coordinates=coordinates,
                        skill_words=frozenset({w for ws in words.values() for w in ws} - set(nouns)
                                              | direction_words),
-                       part_nouns=frozenset(nouns), opposites=opposites, step_words=step_words)
+                       part_nouns=frozenset(nouns), opposites=opposites, step_words=step_words,
+                       way_skills={w: frozenset(k) for w, k in way_skills.items()})
 
 
 _VOCABULARIES: dict[tuple[str, str], _Vocabulary] = {}
@@ -509,11 +517,7 @@ def _ways_gone(affirmed: str, plan: Plan, vocab: _Vocabulary) -> list[Doubt]:
     object or a point ("come back", "go right to the door") goes whichever
     way it must.
     """
-    ways: dict[str, set[str]] = {}
-    for skill, mine, opposite, theirs in vocab.directions:
-        for keyword, said in ((skill, mine), (opposite, theirs)):
-            for way in said:
-                ways.setdefault(way, set()).add(keyword)
+    ways = vocab.way_skills
     directed = {k for keywords in ways.values() for k in keywords}
     moving = [c.skill for c in plan if c.skill in directed or vocab.parts.get(c.skill) == WHOLE]
     if not moving or any(skill not in directed for skill in moving):
@@ -568,8 +572,7 @@ def _one_object(named: list[_Convention], plan: Plan) -> list[Doubt]:
 
 def _negated_done(negated: list[_Convention], plan: Plan, vocab: _Vocabulary) -> list[Doubt]:
     """A convention said only to deny it ("no need to look around") is not carried out."""
-    planned = [(abs(a.value), a.unit) for c in plan if c.skill not in vocab.coordinates
-               for a in c.args if isinstance(a, Quantity)]
+    planned = _amounts(plan, vocab)
     skills = {c.skill for c in plan}
     doubts = []
     for convention in negated:
@@ -629,8 +632,7 @@ def _carried_out(named: list[_Convention], text: str, plan: Plan, vocab: _Vocabu
     said_units = {u for _v, u in _said_numbers(text)}
     count = _counts(text)
     skills = {c.skill for c in plan}
-    planned = [(abs(a.value), a.unit) for c in plan if c.skill not in vocab.coordinates
-               for a in c.args if isinstance(a, Quantity)]
+    planned = _amounts(plan, vocab)
     doubts = []
     for convention in named:
         if convention.default:
@@ -645,6 +647,12 @@ def _carried_out(named: list[_Convention], text: str, plan: Plan, vocab: _Vocabu
             doubts.append(Doubt("convention", f'you said "{convention.phrase}" ({convention.meaning}), '
                                               "but the plan does not do that"))
     return doubts
+
+
+def _amounts(plan: Plan, vocab: _Vocabulary) -> list[tuple[float, str]]:
+    """The amounts the plan's steps take, without sign, less positions."""
+    return [(abs(a.value), a.unit) for c in plan if c.skill not in vocab.coordinates
+            for a in c.args if isinstance(a, Quantity)]
 
 
 def _conventions_said(named: list[_Convention], unit: str) -> float:

@@ -230,6 +230,7 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     ("pick up the water bottle please", "grasp water_bottle;"),
     ("pick up the book gently", "grasp book;"),
     ("go to the red cup, then pick up the cup", "approach red_cup; grasp cup;"),
+    # A fetch acts on one thing; a step to another thing is no fetch; a convention denied is not done.
     ("fetch the ball, good dog!", "approach ball; grasp ball; goto 0, 0;"),
     ("go to the table and pick up the cup", "approach table; grasp cup;"),
     ("no need to look around, just look at what's in front of you", "perceive;"),
