@@ -13,6 +13,9 @@ import re
 
 CORRECTIONS = (", no, {b}", ", sorry, {b}", ", i mean {b}", ", no wait, {b}", ", make that {b}",
                ", actually {b}", ", oops, {b}", ", no sorry, {b}", " - no, {b}", ", or rather {b}")
+# What people also say to take something back, which the training data does not write: the runtime
+# reads them as it reads the templates' words.
+SPOKEN = ("scratch that", "i meant", "correction")
 # The words of each template, longest first so that "no wait" is read before "no".
-MARKERS = tuple(sorted({re.sub(r"[^a-z ]", "", t.replace("{b}", "")).strip() for t in CORRECTIONS},
+MARKERS = tuple(sorted({re.sub(r"[^a-z ]", "", t.replace("{b}", "")).strip() for t in CORRECTIONS} | set(SPOKEN),
                        key=len, reverse=True))

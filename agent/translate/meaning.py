@@ -40,10 +40,18 @@ _STEP_AFTER = re.compile(r",?\s*(?:and\s+then|and|then)\s+[a-z]")
 # could head over"); the word itself is not consumed, so "and then head" finds "head" after "then".
 _CLAUSE_START = re.compile(r"(?:^|[,.;]|\b(?:and|then|so|but|or|you|to|can|could|would|will|should|must)\b)"
                            r"\s*(?=([a-z]+))")
-# What a self-correction takes back: the number or the word right before its marker, when another follows.
-_CORRECTED = rf",?\s+(?:{'|'.join(MARKERS)}),?\s+(?:the |a |an )?"
-_TAKEN_BACK_NUMBER = re.compile(rf"(?<![\w.])(-?\d*\.?\d+)(?: (?:m|rad)\b)?{_CORRECTED}(?=-?\d*\.?\d)")
+# What a self-correction takes back: the number or the word right before its markers ("no, make that"),
+# when another follows.
+_CORRECTED = rf"(?:,?\s+(?:{'|'.join(MARKERS)}))+,?\s+(?:the |a |an )?"
+# The number may be said again with its step ("1 m, no, back up 2 m"), in its unit or bare; a word of
+# sequence between makes the second another step.
+_TAKEN_BACK_NUMBER = re.compile(rf"(?<![\w.])(-?\d*\.?\d+)(?: (m|rad)\b)?{_CORRECTED}"
+                                r"(?=(?:(?!(?:and|then|after|next|also)\b)[a-z']+,? ){0,4}?-?\d*\.?\d+"
+                                r"(?(2) \2\b|(?! (?:m|rad)\b)))")
 _TAKEN_BACK_WORD = re.compile(rf"\b([a-z]+){_CORRECTED}([a-z]+)")
+# An amount taken back by a marker and said again, with its step or without ("back up 1 m, scratch that,
+# back up 0.5 m").
+_CORRECTED_AMOUNT = re.compile(rf"(?<![\w.])(\d*\.?\d+) (m|rad){_CORRECTED}((?:[a-z']+,? ){{0,4}}?)(\d*\.?\d+) \2\b")
 _FIRST_CLAUSE = re.compile(r"[.;]")
 # Two amounts in one unit with only a comma and a few words between: the second may correct the first
 # in words no marker lists ("90 degrees, correction, 45 degrees").
@@ -126,8 +134,9 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     """Every disagreement between the normalized `task` and `plan`; empty when they agree."""
     vocab = _vocabulary(profile)
     text = task.lower()
-    negated = " ".join(m.group(0) for m in _NEGATION.finditer(text))
-    affirmed = _NEGATION.sub(" ", text)
+    # A bare "no" before a correction ("left, no, make that right") takes a word back, not the clause.
+    negated = " ".join(m.group(0) for m in _NEGATION.finditer(text) if m.group(0).strip() not in MARKERS)
+    affirmed = _NEGATION.sub(lambda m: m.group(0) if m.group(0).strip() in MARKERS else " ", text)
     words = _words(affirmed, vocab)
     # The conventions named anywhere bound and allow; only those named outside a negation must be done.
     named = _named(_WORD.findall(text), vocab)
@@ -137,6 +146,7 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     doubts += _numbers(text, plan, vocab, profile)
     doubts += _totals(text, plan, vocab, named)
     doubts += _repeated_after(text, plan, profile)
+    doubts += _repetitions(text, plan, profile)
     doubts += _restated(text, plan, vocab, profile)
     doubts += _doubled(text, plan, profile)
     doubts += _ways_gone(affirmed, plan, vocab)
@@ -468,30 +478,65 @@ def _repeated_after(text: str, plan: Plan, profile: Profile) -> list[Doubt]:
                                 f"repeats all of it ({block})")]
 
 
+def _repetitions(text: str, plan: Plan, profile: Profile) -> list[Doubt]:
+    """A plan that is one block said N times over is that block N times: "..., four times" is no five.
+
+    Only a plan made wholly of one block repeated is read, against the one
+    count said. A shape's sides may multiply the count ("a square, twice"
+    is eight sides), and a word of doing again may add one ("3 times, then
+    once more").
+    """
+    counts = [int(found) for found in _COUNT.findall(text)]
+    steps = [(c.skill, c.args) for c in plan]
+    size = next((s for s in range(1, len(steps) // 2 + 1)
+                 if len(steps) % s == 0 and steps == steps[:s] * (len(steps) // s)), 0)
+    if len(counts) != 1 or counts[0] < 2 or not size:
+        return []
+    said = counts[0]
+    allowed = {said} | {said * sides for shape, sides in _SHAPES.items() if re.search(rf"\b{shape}\b", text)}
+    if _AGAIN.search(text):
+        allowed.add(said + 1)
+    times = len(steps) // size
+    if times in allowed:
+        return []
+    block = ", then ".join(say(c, profile) for c in plan.commands[:size])
+    return [Doubt("repetitions", f"you said {said} times, but the plan does {block} {times} times")]
+
+
 def _restated(text: str, plan: Plan, vocab: _Vocabulary, profile: Profile) -> list[Doubt]:
-    """Two amounts said one after the other, both done by back-to-back steps of one skill.
+    """Two amounts said one after the other, both done by back-to-back steps.
 
     "turn right 90 degrees, correction, 45 degrees" most likely takes the
     first amount back; a word between that names a step, a part or a
-    sequence ("then", "another") makes them two steps.
+    sequence ("then", "another") makes them two steps of one skill. After a
+    marker that takes something back, the step said again ("back up 1 m,
+    scratch that, back up half a metre") is the same step corrected, in
+    whichever order and by whichever skills the plan does both.
     """
     doubts = []
-    for m in _RESTATED.finditer(text):
+    found = [(m, False) for m in _RESTATED.finditer(text)] + [(m, True) for m in _CORRECTED_AMOUNT.finditer(text)]
+    for m, marked in found:
         between = set(_WORD.findall(m.group(3)))
-        if between & (vocab.skill_words | vocab.part_nouns | _SEQUENCE_WORDS):
+        if between & _SEQUENCE_WORDS or (not marked and between & (vocab.skill_words | vocab.part_nouns)):
             continue
         first, second, unit = float(m.group(1)), float(m.group(4)), m.group(2)
         for a, b in itertools.pairwise(plan):
-            amounts = [(x, y) for x, y in zip(a.args, b.args, strict=False)
-                       if isinstance(x, Quantity) and isinstance(y, Quantity) and x.unit == y.unit == unit]
-            if a.skill == b.skill and any(_close(abs(x.value), first) and _close(abs(y.value), second)
-                                          for x, y in amounts):
-                doubts.append(Doubt("restated", f"you said {quantity(Quantity(first, unit))} and then "
-                                                f"{quantity(Quantity(second, unit))}; if the second corrects the "
-                                                f"first, the plan should not do both ({say(a, profile)}, then "
-                                                f"{say(b, profile)})"))
-                break
-    return doubts
+            if not marked and a.skill != b.skill:
+                continue
+            mine = [abs(x.value) for x in a.args if isinstance(x, Quantity) and x.unit == unit]
+            theirs = [abs(y.value) for y in b.args if isinstance(y, Quantity) and y.unit == unit]
+            pairs = [(x, y) for x, y in itertools.product(mine, theirs)]
+            if not any((_close(x, first) and _close(y, second)) or (marked and _close(x, second) and _close(y, first))
+                       for x, y in pairs):
+                continue
+            said = f"{quantity(Quantity(first, unit))} and then {quantity(Quantity(second, unit))}"
+            both = f"{say(a, profile)}, then {say(b, profile)}"
+            doubts.append(Doubt("restated", f"you took back {quantity(Quantity(first, unit))} for "
+                                            f"{quantity(Quantity(second, unit))}, but the plan does both ({both})"
+                                if marked else f"you said {said}; if the second corrects the first, the plan "
+                                               f"should not do both ({both})"))
+            break
+    return list({d.reason: d for d in doubts}.values())
 
 
 def _doubled(text: str, plan: Plan, profile: Profile) -> list[Doubt]:
@@ -524,7 +569,9 @@ def _ways_gone(affirmed: str, plan: Plan, vocab: _Vocabulary) -> list[Doubt]:
         return []
     moved = {vocab.parts.get(skill) for skill in moving}
     planned = {c.skill for c in plan}
-    tokens = ["", *_WORD.findall(affirmed), ""]
+    # "left, no, make that right" takes the first way back.
+    taken_back = {m.start(1) for m in _TAKEN_BACK_WORD.finditer(affirmed) if m.group(2) in ways}
+    tokens = ["", *(m.group(0) for m in _WORD.finditer(affirmed) if m.start() not in taken_back), ""]
     doubts = []
     for before, token, after in zip(tokens, tokens[1:], tokens[2:], strict=False):
         # "pick up", "back up": the way is part of a word that names a step.

@@ -153,6 +153,18 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
      'you said "forget the turn", but the plan still does it (turn left 90°)'),
     ("drive forward without turning", "forward 1; turnleft 1.5708;",
      'you said "without turning", but the plan still does it (turn left 90°)'),
+    # A block said a number of times is done that many times, a shape's sides counted in.
+    ("trace a square: one meter forward, turn left, four times", "forward 1; turnleft 1.5708; " * 5,
+     "you said 4 times, but the plan does drive forward 1 m, then turn left 90° 5 times"),
+    ("nod up and down three times", "lookup 0.5236; lookdown 0.5236; " * 4,
+     "you said 3 times, but the plan does look up 30°, then look down 30° 4 times"),
+    # An amount taken back and said again with its step is not done as well.
+    ("reverse two meters, scratch that, reverse one meter", "backward 1; backward 2;",
+     "you took back 2 m for 1 m, but the plan does both (drive backward 1 m, then drive backward 2 m)"),
+    ("turn left 90 degrees, no, turn right 45 degrees", "turnleft 1.5708; turnright 0.7854;",
+     "you took back 90° for 45°, but the plan does both (turn left 90°, then turn right 45°)"),
+    # A number is taken back by one in its own unit: a turn after "no" corrects no distance.
+    ("drive two meters, no, turn left 90 degrees", "turnleft 1.5708;", "you said 2 m, but the plan never uses it"),
 ])
 def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str, expected: str,
                                                          profile: Profile) -> None:
@@ -243,6 +255,16 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     ("don't forget to look up after you turn left", "turnleft 1.5708; lookup 0.5236;"),
     ("skip the turn and just drive two meters", "forward 2;"),
     ("ignore the cup and turn left", "turnleft 1.5708;"),
+    # A shape said a number of times; a block repeated, and once more.
+    ("drive a square twice", "forward 1; turnleft 1.5708; " * 8),
+    ("look left and right 2 times, then once more", "lookleft 0.5236; lookright 0.5236; " * 3),
+    # What a correction takes back, with its step said again or after several markers, need not be done.
+    ("reverse two meters, scratch that, reverse one meter", "backward 1;"),
+    ("turn right 45, no, make that 90 degrees", "turnright 1.5708;"),
+    ("turn left 90 degrees, no, turn right 45 degrees", "turnright 0.7854;"),
+    ("drive forward 2 meters and then left, no, make that right", "forward 2; turnright 1.5708;"),
+    # A word of sequence after the marker makes another step.
+    ("turn left 90 degrees, no wait, and then turn right 45 degrees", "turnleft 1.5708; turnright 0.7854;"),
 ])
 def test_a_plan_that_does_what_was_said_has_no_doubt(task: str, program: str, profile: Profile) -> None:
     assert reasons(task, program, profile, ["cup", "table", "keys"]) == []
