@@ -14,6 +14,8 @@ compiled against the profile before it is used.
 
 from __future__ import annotations
 
+import hashlib
+import json
 import math
 import random
 import re
@@ -935,6 +937,21 @@ def check_programs(pairs: Iterable[Pair], profile: Profile) -> None:
             details = "; ".join(d.brief() for d in result.diagnostics)
             raise ValueError(f"generated program for task {pair.task!r} does not compile: {details}\n"
                              f"{pair.program}")
+
+
+def pair_record(pair: Pair) -> dict[str, str]:
+    """One pair as `train-adapter --dump-data` writes it, a JSON line each."""
+    return {"task": pair.task, "normalized": pair.normalized, "prompt": pair.prompt, "program": pair.program,
+            "group": pair.group}
+
+
+def data_digest(pairs: Iterable[Pair]) -> str:
+    """The sha256 of `pairs` as dumped: an adapter card keeps it, so a change to the profile, the phrasing
+    templates or the normalizer that would have trained the adapter on other data is found."""
+    digest = hashlib.sha256()
+    for pair in pairs:
+        digest.update((json.dumps(pair_record(pair)) + "\n").encode("utf-8"))
+    return digest.hexdigest()
 
 
 def generate(profile: Profile, count: int, seed: int = 0,

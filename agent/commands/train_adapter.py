@@ -92,7 +92,7 @@ def _train(args: argparse.Namespace) -> int:
               "dump them where the examples were saved", file=sys.stderr)
         return EXIT_USAGE
     from agent.adapter.card import AdapterCard, card_path, sha256_of
-    from agent.adapter.data import generate
+    from agent.adapter.data import data_digest, generate, pair_record
     from agent.adapter.examples import EncodedExamples, read_examples
     from agent.adapter.hygiene import eval_tasks, held_out_filter
     from agent.adapter.prompt import DEFAULT_ADAPTER, PROMPT_VERSION
@@ -135,8 +135,7 @@ def _train(args: argparse.Namespace) -> int:
     if args.dump_data:
         with open(args.dump_data, "w", encoding="utf-8") as handle:
             for pair in pairs:
-                handle.write(json.dumps({"task": pair.task, "normalized": pair.normalized, "prompt": pair.prompt,
-                                         "program": pair.program, "group": pair.group}) + "\n")
+                handle.write(json.dumps(pair_record(pair)) + "\n")
     if args.save_examples:
         return _save_examples(Path(args.save_examples), pairs, base, base_sha, profile, args.seed)
 
@@ -163,7 +162,8 @@ def _train(args: argparse.Namespace) -> int:
         data = {"pairs": encoded.pairs, "encoded": result.examples, "seed": encoded.seed,
                 "groups": encoded.groups, "encoded_with_transformers": encoded.transformers}
     else:
-        data = {"pairs": len(pairs), "encoded": result.examples, "seed": args.seed, "groups": _groups(pairs)}
+        data = {"pairs": len(pairs), "encoded": result.examples, "seed": args.seed, "groups": _groups(pairs),
+                "sha256": data_digest(pairs)}
     card = AdapterCard(
         adapter_file=out.name, adapter_sha256=sha256_of(out), base_model_file=base.name,
         base_model_sha256=base_sha, profile_name=profile.name, profile_sha256=profile.digest,

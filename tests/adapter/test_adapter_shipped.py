@@ -7,7 +7,9 @@ from pathlib import Path
 import pytest
 
 from agent.adapter.card import card_path, read_card, sha256_of
+from agent.adapter.data import data_digest, generate
 from agent.adapter.evaluate import complete, load
+from agent.adapter.hygiene import eval_tasks, held_out_filter
 from agent.adapter.prompt import DEFAULT_ADAPTER, PROMPT_VERSION, adapter_prompt
 from agent.normalize import normalize_task
 from rsl.profile import Profile
@@ -33,6 +35,16 @@ def test_the_card_describes_the_shipped_adapter(base_gguf: Path, profile: Profil
     assert suite["overall"]["n"] == 108 and suite["overall"]["verified"] == 1.0
     assert suite["overall"]["accuracy"] >= 0.95
     assert all(row["accuracy"] >= 0.85 for row in suite.values()), suite
+
+
+def test_the_shipped_adapter_learned_the_data_generated_today(profile: Profile) -> None:
+    # The runtime's normalizer must write what the adapter learned: a change to it, the phrasing templates
+    # or the profile that changes the training data changes what the model is shown, untrained.
+    data = read_card(card_path(DEFAULT_ADAPTER)).data
+    pairs = generate(profile, data["pairs"], seed=data["seed"], exclude=held_out_filter(eval_tasks()))
+    assert data_digest(pairs) == data["sha256"], (
+        "the training data generated today is not what the shipped adapter was trained on; retrain it "
+        "(nrtrans train-adapter) or keep the normalizer and the templates writing what they wrote")
 
 
 @pytest.fixture(scope="module")
