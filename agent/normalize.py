@@ -66,6 +66,8 @@ _REVOLUTIONS = {"turn", "turns", "circle", "circles", "rotation", "rotations", "
 # The ways a turn goes. A bare number after one that is too large to be radians of a turn
 # ("turn left 90") can only be degrees: left as it is, the model copies it into a 90 rad turn.
 _TURN_WAYS = frozenset({"left", "right", "clockwise", "counterclockwise", "anticlockwise", "around"})
+# "do a 180": an article before a bare number of degrees names a turn of that size.
+_ARTICLES = frozenset({"a", "an"})
 _LARGEST_BARE_DEGREES = 360
 
 _FILLERS: tuple[tuple[str, ...], ...] = tuple(
@@ -160,7 +162,7 @@ def _is_number_token(token: str) -> bool:
 
 
 def _parse_integer_words(tokens: Sequence[str], i: int) -> tuple[float, int] | None:
-    """`twenty five`, `one hundred and twenty`, `seven`: value and next index."""
+    """`twenty five`, `one hundred and twenty`, `three sixty`, `seven`: value and next index."""
     value = 0
     last = ""  # the kind of the previous word: ones, tens, hundred, and
     j = i
@@ -171,6 +173,9 @@ def _parse_integer_words(tokens: Sequence[str], i: int) -> tuple[float, int] | N
             value, last = value + _ONES[word], "ones"
         elif word in _TENS and last in ("", "hundred", "and"):
             value, last = value + _TENS[word], "tens"
+        elif word in _TENS and last == "ones" and j == i + 1 and value < 10:
+            # Hundreds said as two numbers, as people say angles: "one eighty", "three sixty".
+            value, last = value * 100 + _TENS[word], "tens"
         elif word == "hundred" and last in ("ones", "tens") and value < 100:
             value, last = value * 100, "hundred"
         elif (word == "and" and last == "hundred" and j + 1 < len(tokens)
@@ -325,6 +330,11 @@ def _convert_at(tokens: list[str], i: int) -> tuple[str, int] | None:
         # The verb stays: "make a u-turn" asks the robot to turn.
         return f"turn {format_number(math.pi)} rad", end
     token = tokens[i]
+    if (token in _ARTICLES and (i == 0 or tokens[i - 1] not in _TURN_WAYS)
+            and (said := _parse_number(tokens, i + 1)) is not None and _unit_at(tokens, said[1]) is None
+            and _bare_degrees(tokens, i + 1, *said)):
+        # As for a U-turn, the verb stays and the turn is named: "do a 180" asks the robot to turn.
+        return f"turn {format_number(math.radians(said[0]))} rad", said[1]
     if (part := _fraction_of(tokens, i)) is not None:
         return part
     parsed = _parse_number(tokens, i)
@@ -358,12 +368,12 @@ def _convert_at(tokens: list[str], i: int) -> tuple[str, int] | None:
 
 
 def _bare_degrees(tokens: Sequence[str], i: int, value: float, end: int) -> bool:
-    """Whether the bare number tokens[i:end] follows a turn's way and is too large to be radians."""
+    """Whether the bare number tokens[i:end] follows a turn's way or an article and is too large to be radians."""
     at = i - 2 if tokens[i - 1:i] == ["by"] else i - 1
     before = tokens[at] if at >= 0 else ""
     after = tokens[end:end + 2]
     coordinate = after[:1] == [","] and len(after) == 2 and _is_number_token(after[1])
-    return (before in _TURN_WAYS and value == int(value) and 2 * math.pi < value <= _LARGEST_BARE_DEGREES
+    return (before in _TURN_WAYS | _ARTICLES and value == int(value) and 2 * math.pi < value <= _LARGEST_BARE_DEGREES
             and after[:1] != ["times"] and not coordinate)
 
 

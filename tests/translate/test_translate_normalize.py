@@ -40,6 +40,11 @@ from agent.normalize import normalize_task
         ("drive point five meters, and then turn", "drive 0.5 m, and then turn"),
         ("do one complete rotation", "do 6.2832 rad"),
         ("spin a whole turn", "spin 6.2832 rad"),
+        # A turn named by its degrees after an article, said as hundreds or in digits.
+        ("pull a one eighty", "pull turn 3.1416 rad"),
+        ("do a 360, then stop", "do turn 6.2832 rad, then stop"),
+        ("turn two seventy degrees", "turn 4.7124 rad"),
+        ("take a 20 cm step forward", "take a 0.2 m step forward"),
         # A U-turn is half a turn, as exact as "half a turn".
         ("make a u-turn", "make turn 3.1416 rad"),
         ("do a U turn to the right", "do turn 3.1416 rad to the right"),
