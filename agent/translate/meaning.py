@@ -393,10 +393,14 @@ def _counts(text: str) -> int:
     count = 1
     for found in _COUNT.findall(text):
         count *= max(1, int(found))
-    for shape, sides in _SHAPES.items():
-        if re.search(rf"\b{shape}\b", text):
-            count *= sides
+    for sides in _sides_said(text):
+        count *= sides
     return count
+
+
+def _sides_said(text: str) -> list[int]:
+    """The sides of each shape the task names ("walk a square": 4)."""
+    return [sides for shape, sides in _SHAPES.items() if re.search(rf"\b{shape}\b", text)]
 
 
 def _close(a: float, b: float) -> bool:
@@ -487,13 +491,15 @@ def _repetitions(text: str, plan: Plan, profile: Profile) -> list[Doubt]:
     once more").
     """
     counts = [int(found) for found in _COUNT.findall(text)]
+    if len(counts) != 1 or counts[0] < 2:
+        return []
     steps = [(c.skill, c.args) for c in plan]
     size = next((s for s in range(1, len(steps) // 2 + 1)
                  if len(steps) % s == 0 and steps == steps[:s] * (len(steps) // s)), 0)
-    if len(counts) != 1 or counts[0] < 2 or not size:
+    if not size:
         return []
     said = counts[0]
-    allowed = {said} | {said * sides for shape, sides in _SHAPES.items() if re.search(rf"\b{shape}\b", text)}
+    allowed = {said} | {said * sides for sides in _sides_said(text)}
     if _AGAIN.search(text):
         allowed.add(said + 1)
     times = len(steps) // size
@@ -525,9 +531,8 @@ def _restated(text: str, plan: Plan, vocab: _Vocabulary, profile: Profile) -> li
                 continue
             mine = [abs(x.value) for x in a.args if isinstance(x, Quantity) and x.unit == unit]
             theirs = [abs(y.value) for y in b.args if isinstance(y, Quantity) and y.unit == unit]
-            pairs = [(x, y) for x, y in itertools.product(mine, theirs)]
             if not any((_close(x, first) and _close(y, second)) or (marked and _close(x, second) and _close(y, first))
-                       for x, y in pairs):
+                       for x, y in itertools.product(mine, theirs)):
                 continue
             said = f"{quantity(Quantity(first, unit))} and then {quantity(Quantity(second, unit))}"
             both = f"{say(a, profile)}, then {say(b, profile)}"
