@@ -137,10 +137,13 @@ def _carry_corrected_units(tokens: list[str]) -> list[str]:
         # Commas may be several: an ellipsis ("30 degrees... no, 60") is read as commas, and so is a
         # filler's ("30 degrees, uh, no, 60") once the filler is dropped.
         j = _past_commas(out, at)
-        marker = next((m for m in _MARKER_WORDS if tuple(out[j:j + len(m)]) == m), None)
+        marker = _marker_at(out, j)
         if marker is None:
             continue
-        j = _past_commas(out, j + len(marker))
+        # Markers may come in a run: "90 degrees, no, make that 45".
+        while marker is not None:
+            j = _past_commas(out, j + len(marker))
+            marker = _marker_at(out, j)
         parsed = _parse_number(out, j)
         if parsed is None:
             continue
@@ -148,7 +151,41 @@ def _carry_corrected_units(tokens: list[str]) -> list[str]:
         if end < len(out) and (out[end] == "times" or _unit_at(out, end) or _revolutions_at(out, end)):
             continue
         out.insert(end, unit)
+    return _carry_correcting_units(out)
+
+
+def _carry_correcting_units(tokens: list[str]) -> list[str]:
+    """A bare number corrected by an amount takes its unit: "forward three, sorry, four metres" is 3 m first.
+
+    Left bare, the number taken back reads as another amount, and the
+    checks would doubt a plan that rightly drops it.
+    """
+    out = list(tokens)
+    for at in range(len(out) - 1, -1, -1):
+        if at and _parse_number(out, at - 1) is not None:
+            continue
+        parsed = _parse_number(out, at)
+        if parsed is None:
+            continue
+        end = parsed[1]
+        if end < len(out) and (out[end] not in (",", *(m[0] for m in _MARKER_WORDS))):
+            continue
+        j = _past_commas(out, end)
+        marker = _marker_at(out, j)
+        if marker is None:
+            continue
+        while marker is not None:
+            j = _past_commas(out, j + len(marker))
+            marker = _marker_at(out, j)
+        corrected = _parse_number(out, j)
+        if corrected is None or (unit := _unit_at(out, corrected[1])) is None:
+            continue
+        out[end:end] = out[corrected[1]:unit[2]]
     return out
+
+
+def _marker_at(tokens: Sequence[str], i: int) -> tuple[str, ...] | None:
+    return next((m for m in _MARKER_WORDS if tuple(tokens[i:i + len(m)]) == m), None)
 
 
 def _past_commas(tokens: Sequence[str], i: int) -> int:

@@ -44,6 +44,11 @@ NOT_NAMES = frozenset({"left", "right", "start", "origin", "beginning", "way", "
                        "back", "end", "middle", "centre", "center", "robot", "side", "distance", "time", "times",
                        "little", "bit", "square", "triangle", "circle", "full", "long", "few", "couple",
                        "point", "position", "spot", "area", "room", "around", "head", "camera"})
+# A closed-class word that is also a thing's last word ("the watering can", "the trash can"); a
+# subject or verb after it makes it the auxiliary ("the cup can you grab").
+_ALSO_NOUNS = frozenset({"can"})
+_AFTER_AUXILIARY = frozenset({"i", "you", "he", "she", "it", "we", "they", "be", "do", "have", "not", "also",
+                              "just", "really", "only", "still", "even", "already", "now"})
 _PAIR = re.compile(rf"\b(?:{'|'.join(DETERMINERS)}) (?=([a-z]+) ([a-z]+)\b(?: ([a-z]+))?)")
 # Endings of words that describe how or what is happening, not what a thing is called.
 _NOT_NAME_ENDINGS = ("ly", "ing")
@@ -66,7 +71,8 @@ def name_pairs(text: str, not_names: Collection[str] = ()) -> list[tuple[str, st
     pairs = []
     for m in _PAIR.finditer(text.lower()):
         first, second, after = m.groups()
-        if (first in never or second in never or second.endswith(_NOT_NAME_ENDINGS)
+        noun = second in _ALSO_NOUNS and after not in _AFTER_AUXILIARY
+        if (first in never or (second in never and not noun) or second.endswith(_NOT_NAME_ENDINGS)
                 or (after is not None and after not in never)):
             continue
         pairs.append((first, second))
@@ -89,5 +95,5 @@ def offered_names(text: str, not_names: Collection[str] = ()) -> tuple[str, ...]
              for before, word in zip(["", *said], said, strict=False)]
     words = [word for word, ok in zip(said, named, strict=True) if ok and word not in in_pairs]
     pairs = [f"{a}_{b}" for (a, b), ok in zip(itertools.pairwise(said), itertools.pairwise(named), strict=False)
-             if all(ok)]
+             if all(ok)] + [f"{a}_{b}" for a, b in name_pairs(text, not_names)]
     return tuple(dict.fromkeys((*words, *pairs)))

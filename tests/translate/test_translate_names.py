@@ -18,6 +18,11 @@ from rsl.profile import load_profile
     ("grab the keys real quick", ()),
     ("grab the cup sitting on the table", ()),
     ("go to the chair near the window", ()),
+    # "can" ends a name when no subject or verb follows it.
+    ("go get the watering can", (("watering", "can"),)),
+    ("take the trash can and then come back", (("trash", "can"),)),
+    ("pick up the cup can you", ()),
+    ("the box can be opened", ()),
     # Amounts, places and the robot's own words are never a name.
     ("move forward a little further", ()),
     ("turn the robot around", ()),
@@ -41,6 +46,8 @@ def test_a_word_said_on_its_own_as_well_is_not_only_in_a_pair() -> None:
     ("fetch the orange instead", ("fetch", "orange")),
     # ... unless a determiner says it does.
     ("grasp the can", ("grasp", "can")),
+    # ... or it ends a name.
+    ("go to the trash can and then return home", ("go", "return", "home", "return_home", "trash_can")),
     # Other words stay, alone and with their neighbours: the model picks.
     ("pick up the book gently", ("pick", "book", "gently", "book_gently")),
     # A self-correction's words name nothing.

@@ -66,6 +66,13 @@ from agent.normalize import normalize_task
         ("go forward three meters, no wait, four", "go forward 3 m, no wait, 4 m"),
         ("turn left 90 degrees, no, 2 times", "turn left 1.5708 rad, no, 2 times"),
         ("drive 2 meters, no, 3 feet", "drive 2 m, no, 0.9144 m"),
+        # ... after a run of markers too.
+        ("turn right ninety degrees, no, make that forty-five", "turn right 1.5708 rad, no, make that 0.7854 rad"),
+        # A bare number corrected by an amount takes the amount's unit; a bare number that is not, stays bare.
+        ("go forward three, sorry, four metres", "go forward 3 m, sorry, 4 m"),
+        ("turn left twenty five, sorry, thirty degrees", "turn left 0.4363 rad, sorry, 0.5236 rad"),
+        ("move 1, then 2 m", "move 1, then 2 m"),
+        ("go to three, no, four, five", "go to 3, no, 4, 5"),
         # A bare number after a turn's way, too large to be radians, is degrees.
         ("turn left 90", "turn left 1.5708 rad"),
         ("rotate clockwise by forty five", "rotate clockwise by 0.7854 rad"),
