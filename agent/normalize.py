@@ -136,15 +136,8 @@ def _carry_corrected_units(tokens: list[str]) -> list[str]:
             continue
         # Commas may be several: an ellipsis ("30 degrees... no, 60") is read as commas, and so is a
         # filler's ("30 degrees, uh, no, 60") once the filler is dropped.
-        j = _past_commas(out, at)
-        marker = _marker_at(out, j)
-        if marker is None:
-            continue
-        # Markers may come in a run: "90 degrees, no, make that 45".
-        while marker is not None:
-            j = _past_commas(out, j + len(marker))
-            marker = _marker_at(out, j)
-        parsed = _parse_number(out, j)
+        j = _past_markers(out, at)
+        parsed = None if j is None else _parse_number(out, j)
         if parsed is None:
             continue
         end = parsed[1]
@@ -170,22 +163,25 @@ def _carry_correcting_units(tokens: list[str]) -> list[str]:
         end = parsed[1]
         if end < len(out) and (out[end] not in (",", *(m[0] for m in _MARKER_WORDS))):
             continue
-        j = _past_commas(out, end)
-        marker = _marker_at(out, j)
-        if marker is None:
-            continue
-        while marker is not None:
-            j = _past_commas(out, j + len(marker))
-            marker = _marker_at(out, j)
-        corrected = _parse_number(out, j)
+        j = _past_markers(out, end)
+        corrected = None if j is None else _parse_number(out, j)
         if corrected is None or (unit := _unit_at(out, corrected[1])) is None:
             continue
         out[end:end] = out[corrected[1]:unit[2]]
     return out
 
 
-def _marker_at(tokens: Sequence[str], i: int) -> tuple[str, ...] | None:
-    return next((m for m in _MARKER_WORDS if tuple(tokens[i:i + len(m)]) == m), None)
+def _past_markers(tokens: Sequence[str], i: int) -> int | None:
+    """Where the words after the correction markers at tokens[i] begin; None if none is there.
+
+    Markers may come in a run ("90 degrees, no, make that 45"), and
+    commas around them may be several.
+    """
+    j = _past_commas(tokens, i)
+    found = False
+    while (marker := next((m for m in _MARKER_WORDS if tuple(tokens[j:j + len(m)]) == m), None)) is not None:
+        j, found = _past_commas(tokens, j + len(marker)), True
+    return j if found else None
 
 
 def _past_commas(tokens: Sequence[str], i: int) -> int:
