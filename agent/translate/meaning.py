@@ -167,13 +167,28 @@ def _words(text: str, vocab: _Vocabulary) -> set[str]:
 
     A part's noun that starts a clause is a verb there ("head over to the
     table"), since the noun would need "your" or "the" before it: it asks
-    the robot as a whole to move, not the part.
+    the robot as a whole to move, not the part. Words of driving right
+    after another part's verb say how that part moves ("look straight
+    ahead"), not that the robot drives.
     """
     tokens = _WORD.findall(text)
     verbs = Counter(m.group(1) for m in _CLAUSE_START.finditer(text) if m.group(1) in vocab.part_nouns)
-    said = Counter(tokens)
+    said = Counter(t for t, how in zip(tokens, _ways_of_parts(tokens, vocab), strict=True) if not how)
     return ({t for t in said if verbs[t] < said[t]} | ({WHOLE} if verbs else set())
             | {a + b for a, b in itertools.pairwise(tokens) if a + b in vocab.skill_words})
+
+
+def _ways_of_parts(tokens: list[str], vocab: _Vocabulary) -> list[bool]:
+    """For each token, whether it is a word of the whole robot said of another part's motion."""
+    part_verbs = {w for part, ws in vocab.part_words.items() if part != WHOLE for w in ws} - vocab.part_nouns
+    whole = vocab.part_words.get(WHOLE, frozenset())
+    how = [False] * len(tokens)
+    for i in range(1, len(tokens)):
+        before = tokens[i - 1]
+        after_verb = how[i - 1] or any(before == w or (len(w) >= 4 and before.startswith(w)
+                                                       and len(before) <= len(w) + 3) for w in part_verbs)
+        how[i] = tokens[i] in whole and after_verb
+    return how
 
 
 def skill_words(profile: Profile) -> frozenset[str]:
@@ -557,6 +572,15 @@ def _doubled(text: str, plan: Plan, profile: Profile) -> list[Doubt]:
             continue
         return [Doubt("doubled", f"the plan does the same step twice in a row ({say(a, profile)}), but you "
                                  "did not ask for it twice")]
+    # Apart too: a step on a thing named once ("fetch the ball, then look around" going for the ball twice).
+    words = Counter(_WORD.findall(text))
+    steps = [(c.skill, c.args) for c in plan]
+    for at, command in enumerate(plan):
+        names = [x.name for x in command.args if isinstance(x, ObjectRef)]
+        if (names and steps[at] in steps[at + 1:]
+                and all(words[w] <= 1 for name in names for w in name.lower().split("_"))):
+            return [Doubt("doubled", f"the plan does the same step twice ({say(command, profile)}), but you "
+                                     "named it once")]
     return []
 
 
@@ -599,14 +623,17 @@ def _cancelled(text: str, plan: Plan, vocab: _Vocabulary, profile: Profile) -> l
     doubts = []
     for command in plan:
         words = vocab.step_words.get(command.skill, frozenset())
-        last = next((at for at, token in reversed(mentions)
-                     if any(token == w or (token.startswith(w.rstrip("e")) and len(token) <= len(w) + 3)
-                            for w in words)), None)
+        last = next((at for at, token in reversed(mentions) if any(_inflected(token, w) for w in words)), None)
         span = next((said for start, end, said in spans if last is not None and start <= last < end), None)
         if span is not None:
             doubts.append(Doubt("cancelled", f'you said "{span}", but the plan still does it '
                                              f"({say(command, profile)})"))
     return list({d.reason: d for d in doubts}.values())
+
+
+def _inflected(token: str, word: str) -> bool:
+    """Whether `token` is `word` or one of its inflections ("turning", "grabbed")."""
+    return token == word or (token.startswith(word.rstrip("e")) and len(token) <= len(word) + 3)
 
 
 def _one_object(named: list[_Convention], plan: Plan) -> list[Doubt]:
@@ -718,6 +745,8 @@ def _vague_amount(named: list[_Convention], vocab: _Vocabulary, unit: str) -> fl
     return max((v for values in used for v in values.get(unit, ())), default=0.0)
 
 
+# Words that say a thing again without its name.
+_REFERS_BACK = re.compile(r"\b(?:it|them|there)\b")
 # A negation word that also starts a self-correction ("no, the keys") corrects rather than denies.
 _CORRECTING = frozenset(m.split()[0] for m in MARKERS)
 
@@ -727,12 +756,17 @@ def _objects(text: str, plan: Plan, known: Collection[str] | None, vocab: _Vocab
     known_words = {w for name in known or () for w in name.lower().split("_")}
     taken_back = {m.group(1) for m in _TAKEN_BACK_WORD.finditer(text) if m.group(2) in known_words}
     words = set(_WORD.findall(text))
-    # "not the chair" denies an object; "no, the keys" corrects to one.
+    # "not the chair" denies an object; "no, the keys" corrects to one. "don't grab the mug, just go to it"
+    # denies a step the plan leaves out, and the rest says the thing again.
     denied: set[str] = set()
+    planned_skills = {c.skill for c in plan}
+    said_again = _REFERS_BACK.search(_NEGATION.sub(" ", text)) is not None
 
     def deny(m: re.Match[str]) -> str:
         said = _WORD.findall(m.group(0))
-        if said[0] in _CORRECTING:
+        steps = {skill for skill, step_words in vocab.step_words.items()
+                 if any(_inflected(token, w) for token in said for w in step_words)}
+        if said[0] in _CORRECTING or (said_again and steps and not steps & planned_skills):
             return m.group(0)
         denied.update(said)
         return " "

@@ -158,6 +158,16 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
      "you said 4 times, but the plan does drive forward 1 m, then turn left 90° 5 times"),
     ("nod up and down three times", "lookup 0.5236; lookdown 0.5236; " * 4,
      "you said 3 times, but the plan does look up 30°, then look down 30° 4 times"),
+    # A thing said only where a step is denied is denied, unless the step is left out and the thing said again.
+    ("don't approach the cup, grab the ball", "grasp cup;", "you said not the cup, but the plan uses it"),
+    ("don't grab the mug, just go to it", "approach mug; grasp mug;", "you said not the mug, but the plan uses it"),
+    # Words of driving said of how the head moves ask for no drive.
+    ("look left 30 degrees, then look straight ahead again", "lookleft 0.5236; forward 1;",
+     "you asked about the head, but the plan moves the base (drive forward 1 m)"),
+    # A step on a thing named once is done once, apart or in a row.
+    ("fetch the ball, then look around",
+     "approach ball; lookleft 1.5708; perceive; lookright 3.1416; perceive; lookleft 1.5708; approach ball; "
+     "grasp ball; goto 0, 0;", "the plan does the same step twice (drive up to the ball), but you named it once"),
     # An amount taken back and said again with its step is not done as well.
     ("reverse two meters, scratch that, reverse one meter", "backward 1; backward 2;",
      "you took back 2 m for 1 m, but the plan does both (drive backward 1 m, then drive backward 2 m)"),
@@ -258,6 +268,12 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     # A shape said a number of times; a block repeated, and once more.
     ("drive a square twice", "forward 1; turnleft 1.5708; " * 8),
     ("look left and right 2 times, then once more", "lookleft 0.5236; lookright 0.5236; " * 3),
+    ("don't grab the mug, just go to it", "approach mug;"),
+    ("go to the table, look around, and come back to the table",
+     "approach table; lookleft 1.5708; perceive; lookright 3.1416; perceive; lookleft 1.5708; approach table;"),
+    # Words of driving after the verb of driving ask for it.
+    ("head straight ahead two metres", "forward 2;"),
+    ("don't move your head, just drive straight ahead two metres", "forward 2;"),
     # What a correction takes back, with its step said again or after several markers, need not be done.
     ("reverse two meters, scratch that, reverse one meter", "backward 1;"),
     ("turn right 45, no, make that 90 degrees", "turnright 1.5708;"),
