@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from agent.corrections import MARKERS
 from agent.translate.clauses import _SHAPES
 from agent.translate.explain import quantity, say
-from agent.translate.names import DETERMINERS
+from agent.translate.names import DETERMINERS, FUNCTION_WORDS
 from rsl.compiler import compile_program
 from rsl.plan import ObjectRef, Plan, Quantity
 from rsl.profile import Profile
@@ -141,7 +141,8 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     # The conventions named anywhere bound and allow; only those named outside a negation must be done.
     named = _named(_WORD.findall(text), vocab)
     doubts: list[Doubt] = []
-    doubts += _parts(plan, vocab, words, set(_WORD.findall(negated)), named, profile)
+    doubts += _parts(plan, vocab, words, set(_WORD.findall(negated)), named, profile,
+                     _asked_by_unlisted_verbs(affirmed, vocab))
     doubts += _directions(plan, vocab, words, named, profile)
     doubts += _numbers(text, plan, vocab, profile)
     doubts += _totals(text, plan, vocab, named)
@@ -189,6 +190,28 @@ def _ways_of_parts(tokens: list[str], vocab: _Vocabulary) -> list[bool]:
                                                        and len(before) <= len(w) + 3) for w in part_verbs)
         how[i] = tokens[i] in whole and after_verb
     return how
+
+
+def _asked_by_unlisted_verbs(text: str, vocab: _Vocabulary) -> set[str]:
+    """The parts asked for by a verb the profile does not list, told by the way and amount after it.
+
+    "scoot back 1 m", "roll forward a little": a word that starts a clause
+    and names nothing the profile knows, followed by a way only one part
+    goes and an amount, asks for that part as its own words would.
+    """
+    known = vocab.skill_words | vocab.part_nouns | FUNCTION_WORDS
+    amounts = "|".join(re.escape(c.phrase) for c in vocab.conventions if c.amounts and not c.whole and not c.default)
+    shape = re.compile(rf"\s+([a-z]+)\s+(?:\d*\.?\d+|{amounts})\b")
+    found: set[str] = set()
+    for m in _CLAUSE_START.finditer(text):
+        verb = m.group(1)
+        after = shape.match(text, m.end(1))
+        if verb in known or len(verb) < 3 or after is None:
+            continue
+        parts = {vocab.parts.get(k, WHOLE) for k in vocab.way_skills.get(after.group(1), ())}
+        if len(parts) == 1:
+            found |= parts
+    return found
 
 
 def skill_words(profile: Profile) -> frozenset[str]:
@@ -349,11 +372,11 @@ def _said(words: Iterable[str], direction: frozenset[str]) -> bool:
 
 
 def _parts(plan: Plan, vocab: _Vocabulary, words: set[str], negated: set[str], named: list[_Convention],
-           profile: Profile) -> list[Doubt]:
+           profile: Profile, also_asked: set[str]) -> list[Doubt]:
     """The base moves only when asked for motion; a request about the head moves only the head."""
     used = {vocab.parts.get(c.skill, WHOLE) for c in plan}
     allowed = {skill for c in named for skill in c.skills}
-    asked = {part for part, ws in vocab.part_words.items() if words & ws}
+    asked = {part for part, ws in vocab.part_words.items() if words & ws} | also_asked
     doubts = []
     for part in sorted(used):
         moving = [c for c in plan if vocab.parts.get(c.skill) == part and c.skill not in allowed]

@@ -164,6 +164,10 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
     # Words of driving said of how the head moves ask for no drive.
     ("look left 30 degrees, then look straight ahead again", "lookleft 0.5236; forward 1;",
      "you asked about the head, but the plan moves the base (drive forward 1 m)"),
+    # A verb the profile does not list asks for the part its way and amount tell, and only for that part.
+    ("scoot back a little", "lookup 0.2618;", "you asked about the base, but the plan moves the head (look up 15°)"),
+    ("the ball rolled forward 2 metres", "forward 2;",
+     "you did not ask the robot to move, but the plan does (drive forward 2 m)"),
     # A step on a thing named once is done once, apart or in a row.
     ("fetch the ball, then look around",
      "approach ball; lookleft 1.5708; perceive; lookright 3.1416; perceive; lookleft 1.5708; approach ball; "
@@ -269,6 +273,9 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     ("drive a square twice", "forward 1; turnleft 1.5708; " * 8),
     ("look left and right 2 times, then once more", "lookleft 0.5236; lookright 0.5236; " * 3),
     ("don't grab the mug, just go to it", "approach mug;"),
+    ("roll forward eighteen inches, nice and slow", "forward 0.4572;"),
+    ("hey buddy, can you scoot back a little for me?", "backward 0.2;"),
+    ("peek up a little", "lookup 0.2618;"),
     ("go to the table, look around, and come back to the table",
      "approach table; lookleft 1.5708; perceive; lookright 3.1416; perceive; lookleft 1.5708; approach table;"),
     # Words of driving after the verb of driving ask for it.
