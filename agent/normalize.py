@@ -90,6 +90,7 @@ def normalize_task(text: str) -> str:
     tokens = _tokenize(text)
     tokens = _drop_fillers(tokens)
     tokens = _carry_corrected_units(tokens)
+    tokens = _carry_correcting_units(tokens)
     tokens = _convert_numbers(tokens)
     return _render(tokens)
 
@@ -144,7 +145,7 @@ def _carry_corrected_units(tokens: list[str]) -> list[str]:
         if end < len(out) and (out[end] == "times" or _unit_at(out, end) or _revolutions_at(out, end)):
             continue
         out.insert(end, unit)
-    return _carry_correcting_units(out)
+    return out
 
 
 def _carry_correcting_units(tokens: list[str]) -> list[str]:
@@ -161,8 +162,6 @@ def _carry_correcting_units(tokens: list[str]) -> list[str]:
         if parsed is None:
             continue
         end = parsed[1]
-        if end < len(out) and (out[end] not in (",", *(m[0] for m in _MARKER_WORDS))):
-            continue
         j = _past_markers(out, end)
         corrected = None if j is None else _parse_number(out, j)
         if corrected is None or (unit := _unit_at(out, corrected[1])) is None:

@@ -111,6 +111,9 @@ class _Vocabulary:
     opposites: dict[str, str]  # skill keyword -> its opposite, both ways
     step_words: dict[str, frozenset[str]]  # skill keyword -> the words that ask for that step
     way_skills: dict[str, frozenset[str]]  # way ("left") -> the skills that go it (turnleft, lookleft)
+    part_verbs: frozenset[str]  # the words of parts other than the base that are no noun ("look", "tilt")
+    known_words: frozenset[str]  # what a verb the profile does not list is not: its words and closed-class words
+    way_and_amount: re.Pattern[str]  # a way, then a number or a convention's amount ("back a little")
 
 
 @dataclass(frozen=True)
@@ -156,7 +159,7 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     doubts += _carried_out(affirmed_named, text, plan, vocab)
     doubts += _one_object(named, plan)
     doubts += _negated_done([c for c in named if c not in affirmed_named], plan, vocab)
-    doubts += _objects(text, plan, known_objects, vocab)
+    doubts += _objects(text, affirmed, plan, known_objects, vocab)
     if _QUESTION.match(text):
         doubts.append(Doubt("question", f"you asked a question, not for the robot to act, but the plan acts "
                                         f"({say(plan.commands[0], profile)})"))
@@ -181,13 +184,12 @@ def _words(text: str, vocab: _Vocabulary) -> set[str]:
 
 def _ways_of_parts(tokens: list[str], vocab: _Vocabulary) -> list[bool]:
     """For each token, whether it is a word of the whole robot said of another part's motion."""
-    part_verbs = {w for part, ws in vocab.part_words.items() if part != WHOLE for w in ws} - vocab.part_nouns
     whole = vocab.part_words.get(WHOLE, frozenset())
     how = [False] * len(tokens)
     for i in range(1, len(tokens)):
         before = tokens[i - 1]
         after_verb = how[i - 1] or any(before == w or (len(w) >= 4 and before.startswith(w)
-                                                       and len(before) <= len(w) + 3) for w in part_verbs)
+                                                       and len(before) <= len(w) + 3) for w in vocab.part_verbs)
         how[i] = tokens[i] in whole and after_verb
     return how
 
@@ -199,14 +201,11 @@ def _asked_by_unlisted_verbs(text: str, vocab: _Vocabulary) -> set[str]:
     and names nothing the profile knows, followed by a way only one part
     goes and an amount, asks for that part as its own words would.
     """
-    known = vocab.skill_words | vocab.part_nouns | FUNCTION_WORDS
-    amounts = "|".join(re.escape(c.phrase) for c in vocab.conventions if c.amounts and not c.whole and not c.default)
-    shape = re.compile(rf"\s+([a-z]+)\s+(?:\d*\.?\d+|{amounts})\b")
     found: set[str] = set()
     for m in _CLAUSE_START.finditer(text):
         verb = m.group(1)
-        after = shape.match(text, m.end(1))
-        if verb in known or len(verb) < 3 or after is None:
+        after = vocab.way_and_amount.match(text, m.end(1))
+        if verb in vocab.known_words or len(verb) < 3 or after is None:
             continue
         parts = {vocab.parts.get(k, WHOLE) for k in vocab.way_skills.get(after.group(1), ())}
         if len(parts) == 1:
@@ -331,13 +330,16 @@ def _build_vocabulary(profile: Profile) -> _Vocabulary:
         for keyword, said in ((skill_keyword, mine_words), (opposite_keyword, theirs_words)):
             for way in said:
                 way_skills.setdefault(way, set()).add(keyword)
+    skill_word_set = frozenset({w for ws in words.values() for w in ws} - set(nouns) | direction_words)
+    amount_phrases = "|".join(re.escape(c.phrase) for c in conventions if c.amounts and not c.whole and not c.default)
     return _Vocabulary(parts=parts, part_words=part_words, directions=tuple(ways),
                        convention_numbers={u: frozenset(v) for u, v in numbers.items()},
                        conventions=tuple(conventions), coordinates=coordinates,
-                       skill_words=frozenset({w for ws in words.values() for w in ws} - set(nouns)
-                                             | direction_words),
-                       part_nouns=frozenset(nouns), opposites=opposites, step_words=step_words,
-                       way_skills={w: frozenset(k) for w, k in way_skills.items()})
+                       skill_words=skill_word_set, part_nouns=frozenset(nouns), opposites=opposites,
+                       step_words=step_words, way_skills={w: frozenset(k) for w, k in way_skills.items()},
+                       part_verbs=frozenset(w for p, ws in part_words.items() if p != WHOLE for w in ws) - set(nouns),
+                       known_words=skill_word_set | frozenset(nouns) | FUNCTION_WORDS,
+                       way_and_amount=re.compile(rf"\s+([a-z]+)\s+(?:\d*\.?\d+|{amount_phrases})\b"))
 
 
 _VOCABULARIES: dict[tuple[str, str], _Vocabulary] = {}
@@ -774,7 +776,8 @@ _REFERS_BACK = re.compile(r"\b(?:it|them|there)\b")
 _CORRECTING = frozenset(m.split()[0] for m in MARKERS)
 
 
-def _objects(text: str, plan: Plan, known: Collection[str] | None, vocab: _Vocabulary) -> list[Doubt]:
+def _objects(text: str, affirmed_text: str, plan: Plan, known: Collection[str] | None, vocab: _Vocabulary
+             ) -> list[Doubt]:
     """Every object in the plan was said, and every known object said is in the plan."""
     known_words = {w for name in known or () for w in name.lower().split("_")}
     taken_back = {m.group(1) for m in _TAKEN_BACK_WORD.finditer(text) if m.group(2) in known_words}
@@ -783,7 +786,7 @@ def _objects(text: str, plan: Plan, known: Collection[str] | None, vocab: _Vocab
     # denies a step the plan leaves out, and the rest says the thing again.
     denied: set[str] = set()
     planned_skills = {c.skill for c in plan}
-    said_again = _REFERS_BACK.search(_NEGATION.sub(" ", text)) is not None
+    said_again = _REFERS_BACK.search(affirmed_text) is not None
 
     def deny(m: re.Match[str]) -> str:
         said = _WORD.findall(m.group(0))

@@ -56,7 +56,11 @@ _NOT_NAME_ENDINGS = ("ly", "ing")
 
 def said_only_in_pairs(text: str, not_names: Collection[str] = ()) -> frozenset[str]:
     """The words of the pairs `text` names things by that it never says on their own ("the red cup")."""
-    inside = Counter(word for pair in name_pairs(text, not_names) for word in pair)
+    return _only_in(name_pairs(text, not_names), text)
+
+
+def _only_in(pairs: list[tuple[str, str]], text: str) -> frozenset[str]:
+    inside = Counter(word for pair in pairs for word in pair)
     said = Counter(re.findall(r"[a-z]+", text.lower()))
     return frozenset(word for word, count in inside.items() if said[word] <= count)
 
@@ -89,11 +93,12 @@ def offered_names(text: str, not_names: Collection[str] = ()) -> tuple[str, ...]
     unless a determiner says it does ("grasp the can"): offered, the model wrote `approach bottle_and;`
     for "the water bottle and pick it up". `not_names` as for `name_pairs`.
     """
-    in_pairs = said_only_in_pairs(text, not_names)
+    found = name_pairs(text, not_names)
+    in_pairs = _only_in(found, text)
     said = re.findall(r"[a-z]+", text.lower())
     named = [word not in NOT_NAMES and word not in DETERMINERS and (word not in FUNCTION_WORDS or before in DETERMINERS)
              for before, word in zip(["", *said], said, strict=False)]
     words = [word for word, ok in zip(said, named, strict=True) if ok and word not in in_pairs]
     pairs = [f"{a}_{b}" for (a, b), ok in zip(itertools.pairwise(said), itertools.pairwise(named), strict=False)
-             if all(ok)] + [f"{a}_{b}" for a, b in name_pairs(text, not_names)]
+             if all(ok)] + [f"{a}_{b}" for a, b in found]
     return tuple(dict.fromkeys((*words, *pairs)))
