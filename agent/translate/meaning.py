@@ -53,6 +53,7 @@ _TAKEN_BACK_WORD = re.compile(rf"\b([a-z]+){_CORRECTED}([a-z]+)")
 # back up 0.5 m").
 _CORRECTED_AMOUNT = re.compile(rf"(?<![\w.])(\d*\.?\d+) (m|rad){_CORRECTED}((?:[a-z']+,? ){{0,4}}?)(\d*\.?\d+) \2\b")
 _FIRST_CLAUSE = re.compile(r"[.;]")
+_NEXT_WORD = re.compile(r"\s+([a-z]+)")
 # Two amounts in one unit with only a comma and a few words between: the second may correct the first
 # in words no marker lists ("90 degrees, correction, 45 degrees").
 _RESTATED = re.compile(r"(?<![\w.])(\d*\.?\d+) (m|rad),((?: [a-z']+){0,3}?),? (\d*\.?\d+) \2\b")
@@ -76,6 +77,8 @@ _CANCELLED = re.compile(rf"(?<!\bwhy )\b(?:{_NEGATORS}|skip|cancel|scrap|omit|ig
 _PLACE_OR_TIME = frozenset({"now", "away", "here", "there", "after", "before", "behind", "next", "of", "in", "at",
                             "on", "beside", "by"})
 _OWNER = frozenset({"the", "your", "my", "its", "his", "her", "their", "all"})
+# A part the task keeps the plan to: "only your head", "with the head only".
+_ONLY = (re.compile(r"\bonly (?:with |using )?(?:your |the |its )?([a-z]+)"), re.compile(r"\b([a-z]+) only\b"))
 # A question about the robot, asked and left there ("why do you keep looking up"), is no request;
 # "why don't you look up" suggests ("don't" is no auxiliary here), and a request after it
 # ("what are you waiting for, go forward") is one.
@@ -114,6 +117,10 @@ class _Vocabulary:
     part_verbs: frozenset[str]  # the words of parts other than the base that are no noun ("look", "tilt")
     known_words: frozenset[str]  # what a verb the profile does not list is not: its words and closed-class words
     way_and_amount: re.Pattern[str]  # a way, then a number or a convention's amount ("back a little")
+    # The first word of a whole command that is no skill's word ("face" of "face behind") -> the parts
+    # its program moves.
+    command_verbs: dict[str, frozenset[str]]
+    noun_parts: dict[str, str]  # a part's noun ("camera") -> its part ("head")
 
 
 @dataclass(frozen=True)
@@ -145,7 +152,7 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     named = _named(_WORD.findall(text), vocab)
     doubts: list[Doubt] = []
     doubts += _parts(plan, vocab, words, set(_WORD.findall(negated)), named, profile,
-                     _asked_by_unlisted_verbs(affirmed, vocab))
+                     _asked_by_unlisted_verbs(affirmed, vocab), _asked_by_command_verbs(affirmed, vocab))
     doubts += _directions(plan, vocab, words, named, profile)
     doubts += _numbers(text, plan, vocab, profile)
     doubts += _totals(text, plan, vocab, named)
@@ -155,6 +162,7 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     doubts += _doubled(text, plan, profile)
     doubts += _ways_gone(affirmed, plan, vocab)
     doubts += _cancelled(text, plan, vocab, profile)
+    doubts += _only(affirmed, plan, vocab, named, profile)
     affirmed_named = _named(_WORD.findall(affirmed), vocab)
     doubts += _carried_out(affirmed_named, text, plan, vocab)
     doubts += _one_object(named, plan)
@@ -210,6 +218,24 @@ def _asked_by_unlisted_verbs(text: str, vocab: _Vocabulary) -> set[str]:
         parts = {vocab.parts.get(k, WHOLE) for k in vocab.way_skills.get(after.group(1), ())}
         if len(parts) == 1:
             found |= parts
+    return found
+
+
+def _asked_by_command_verbs(text: str, vocab: _Vocabulary) -> set[str]:
+    """The steps a whole command's own verb asks for, told by the way after it.
+
+    "face left": the word that starts a whole command of the profile ("face
+    behind", a turn of the base) and no skill's words, followed by a way,
+    asks for the steps of that way on the parts the command moves (turning
+    left), and for nothing else ("face right, toward the window" asks for
+    no drive to the window).
+    """
+    found: set[str] = set()
+    for m in _CLAUSE_START.finditer(text):
+        parts = vocab.command_verbs.get(m.group(1))
+        way = _NEXT_WORD.match(text, m.end(1)) if parts else None
+        if parts and way:
+            found |= {k for k in vocab.way_skills.get(way.group(1), ()) if vocab.parts.get(k, WHOLE) in parts}
     return found
 
 
@@ -331,6 +357,11 @@ def _build_vocabulary(profile: Profile) -> _Vocabulary:
             for way in said:
                 way_skills.setdefault(way, set()).add(keyword)
     skill_word_set = frozenset({w for ws in words.values() for w in ws} - set(nouns) | direction_words)
+    known_words = skill_word_set | frozenset(nouns) | FUNCTION_WORDS
+    command_verbs: dict[str, set[str]] = {}
+    for c in conventions:
+        if c.whole and c.words and c.words[0] not in known_words:
+            command_verbs.setdefault(c.words[0], set()).update(parts.get(k, WHOLE) for k in c.skills)
     amount_phrases = "|".join(re.escape(c.phrase) for c in conventions if c.amounts and not c.whole and not c.default)
     return _Vocabulary(parts=parts, part_words=part_words, directions=tuple(ways),
                        convention_numbers={u: frozenset(v) for u, v in numbers.items()},
@@ -338,8 +369,10 @@ def _build_vocabulary(profile: Profile) -> _Vocabulary:
                        skill_words=skill_word_set, part_nouns=frozenset(nouns), opposites=opposites,
                        step_words=step_words, way_skills={w: frozenset(k) for w, k in way_skills.items()},
                        part_verbs=frozenset(w for p, ws in part_words.items() if p != WHOLE for w in ws) - set(nouns),
-                       known_words=skill_word_set | frozenset(nouns) | FUNCTION_WORDS,
-                       way_and_amount=re.compile(rf"\s+([a-z]+)\s+(?:\d*\.?\d+|{amount_phrases})\b"))
+                       known_words=known_words,
+                       way_and_amount=re.compile(rf"\s+([a-z]+)\s+(?:\d*\.?\d+|{amount_phrases})\b"),
+                       command_verbs={w: frozenset(ps) for w, ps in command_verbs.items()},
+                       noun_parts=nouns)
 
 
 _VOCABULARIES: dict[tuple[str, str], _Vocabulary] = {}
@@ -374,10 +407,10 @@ def _said(words: Iterable[str], direction: frozenset[str]) -> bool:
 
 
 def _parts(plan: Plan, vocab: _Vocabulary, words: set[str], negated: set[str], named: list[_Convention],
-           profile: Profile, also_asked: set[str]) -> list[Doubt]:
+           profile: Profile, also_asked: set[str], steps_asked: set[str]) -> list[Doubt]:
     """The base moves only when asked for motion; a request about the head moves only the head."""
     used = {vocab.parts.get(c.skill, WHOLE) for c in plan}
-    allowed = {skill for c in named for skill in c.skills}
+    allowed = {skill for c in named for skill in c.skills} | steps_asked
     asked = {part for part, ws in vocab.part_words.items() if words & ws} | also_asked
     doubts = []
     for part in sorted(used):
@@ -654,6 +687,23 @@ def _cancelled(text: str, plan: Plan, vocab: _Vocabulary, profile: Profile) -> l
             doubts.append(Doubt("cancelled", f'you said "{span}", but the plan still does it '
                                              f"({say(command, profile)})"))
     return list({d.reason: d for d in doubts}.values())
+
+
+def _only(affirmed: str, plan: Plan, vocab: _Vocabulary, named: list[_Convention], profile: Profile
+          ) -> list[Doubt]:
+    """A part said with "only" ("turn left, but only your head") is the only part that moves."""
+    kept = {vocab.noun_parts[m.group(1)] for pattern in _ONLY for m in pattern.finditer(affirmed)
+            if m.group(1) in vocab.noun_parts}
+    if not kept:
+        return []
+    # A whole command named ("look around") may move what it moves; an amount's convention excuses nothing.
+    allowed = {skill for c in named if c.whole for skill in c.skills}
+    moving = [c for c in plan if vocab.parts.get(c.skill, WHOLE) not in kept and c.skill not in allowed]
+    if not moving:
+        return []
+    said = " or ".join(f"the {p}" for p in sorted(kept))
+    return [Doubt("only", f"you asked to move only {said}, but the plan moves the "
+                          f"{vocab.parts.get(moving[0].skill, WHOLE)} ({say(moving[0], profile)})")]
 
 
 def _inflected(token: str, word: str) -> bool:

@@ -166,6 +166,14 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
      "you asked about the head, but the plan moves the base (drive forward 1 m)"),
     # A verb the profile does not list asks for the part its way and amount tell, and only for that part.
     ("scoot back a little", "lookup 0.2618;", "you asked about the base, but the plan moves the head (look up 15°)"),
+    # A whole command's verb with a way asks for that way's steps of the command's parts, and nothing else.
+    ("face right, toward the window", "turnright 1.5708; approach window;",
+     "you did not ask the robot to move, but the plan does (drive up to the window)"),
+    # A part said with "only" is the only part that moves.
+    ("turn left 90 degrees with your head only", "turnleft 1.5708;",
+     "you asked to move only the head, but the plan moves the base (turn left 90°)"),
+    ("turn right, but only the head", "lookright 0.5236; turnright 1.5708;",
+     "you asked to move only the head, but the plan moves the base (turn right 90°)"),
     ("the ball rolled forward 2 metres", "forward 2;",
      "you did not ask the robot to move, but the plan does (drive forward 2 m)"),
     # A step on a thing named once is done once, apart or in a row.
@@ -275,6 +283,11 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     ("don't grab the mug, just go to it", "approach mug;"),
     ("roll forward eighteen inches, nice and slow", "forward 0.4572;"),
     ("hey buddy, can you scoot back a little for me?", "backward 0.2;"),
+    # "face" starts the profile's "face behind", a turn of the base: "face left" asks for the turn.
+    ("face left", "turnleft 1.5708;"),
+    ("look right, then face left", "lookright 0.5236; turnleft 1.5708;"),
+    ("look around, only your head", "lookleft 1.5708; perceive; lookright 3.1416; perceive; lookleft 1.5708;"),
+    ("go forward only 2 metres", "forward 2;"),
     ("peek up a little", "lookup 0.2618;"),
     ("go to the table, look around, and come back to the table",
      "approach table; lookleft 1.5708; perceive; lookright 3.1416; perceive; lookleft 1.5708; approach table;"),
@@ -292,6 +305,16 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
 def test_a_plan_that_does_what_was_said_has_no_doubt(task: str, program: str, profile: Profile) -> None:
     assert reasons(task, program, profile, ["cup", "table", "keys"]) == []
     assert assess(normalize_task(task), plan(program, profile), profile, model=0.9).confidence == 0.9
+
+
+def test_a_whole_command_verb_comes_from_the_profile(profile: Profile) -> None:
+    text = Path(profile.source).read_text(encoding="utf-8")
+    without = re.sub(r'\[\[conventions\]\]\nphrase = "face behind"\n(?:.+\n)+', "", text)
+    assert without != text
+    other = parse_profile(without)
+    task = normalize_task("face left")
+    assert check_meaning(task, plan("turnleft 1.5708;", profile), profile) == ()
+    assert [d.check for d in check_meaning(task, plan("turnleft 1.5708;", other), other)] == ["motion"]
 
 
 def test_a_robot_described_otherwise_gets_its_own_parts(profile: Profile) -> None:
