@@ -54,6 +54,8 @@ _TAKEN_BACK_WORD = re.compile(rf"\b([a-z]+){_CORRECTED}([a-z]+)")
 _CORRECTED_AMOUNT = re.compile(rf"(?<![\w.])(\d*\.?\d+) (m|rad){_CORRECTED}((?:[a-z']+,? ){{0,4}}?)(\d*\.?\d+) \2\b")
 _FIRST_CLAUSE = re.compile(r"[.;]")
 _NEXT_WORD = re.compile(r"\s+([a-z]+)")
+# A point said whole: two numbers joined by a comma ("the point 3, -2").
+_POINT = re.compile(r"(?<![\w.])(-?\d*\.?\d+), (-?\d*\.?\d+)(?![\w.])")
 # Two amounts in one unit with only a comma and a few words between: the second may correct the first
 # in words no marker lists ("90 degrees, correction, 45 degrees").
 _RESTATED = re.compile(r"(?<![\w.])(\d*\.?\d+) (m|rad),((?: [a-z']+){0,3}?),? (\d*\.?\d+) \2\b")
@@ -152,7 +154,8 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     named = _named(_WORD.findall(text), vocab)
     doubts: list[Doubt] = []
     doubts += _parts(plan, vocab, words, set(_WORD.findall(negated)), named, profile,
-                     _asked_by_unlisted_verbs(affirmed, vocab), _asked_by_command_verbs(affirmed, vocab))
+                     _asked_by_unlisted_verbs(affirmed, vocab) | _points_asked(affirmed, plan, vocab),
+                     _asked_by_command_verbs(affirmed, vocab))
     doubts += _directions(plan, vocab, words, named, profile)
     doubts += _numbers(text, plan, vocab, profile)
     doubts += _totals(text, plan, vocab, named)
@@ -236,6 +239,19 @@ def _asked_by_command_verbs(text: str, vocab: _Vocabulary) -> set[str]:
         way = _NEXT_WORD.match(text, m.end(1)) if parts else None
         if parts and way:
             found |= {k for k in vocab.way_skills.get(way.group(1), ()) if vocab.parts.get(k, WHOLE) in parts}
+    return found
+
+
+def _points_asked(text: str, plan: Plan, vocab: _Vocabulary) -> set[str]:
+    """The parts of the steps that go to a point said whole, whatever verb carries it ("proceed to
+    the point 4, 1", "I need you over at 3, -2"): a person names a point to have the robot go there."""
+    said = [(float(x), float(y)) for x, y in _POINT.findall(text)]
+    found: set[str] = set()
+    for c in plan:
+        values = [a.value for a in c.args if isinstance(a, Quantity)]
+        if c.skill in vocab.coordinates and len(values) == 2 and any(
+                _close(values[0], x) and _close(values[1], y) for x, y in said):
+            found.add(vocab.parts.get(c.skill, WHOLE))
     return found
 
 

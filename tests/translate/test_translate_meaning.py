@@ -176,6 +176,9 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
      "you asked to move only the head, but the plan moves the base (turn right 90°)"),
     ("the ball rolled forward 2 metres", "forward 2;",
      "you did not ask the robot to move, but the plan does (drive forward 2 m)"),
+    # Only the point said asks for the drive there.
+    ("proceed to the point 4, 1", "goto 1, 4;",
+     "you did not ask the robot to move, but the plan does (drive to the point (1 m, 4 m))"),
     # A step on a thing named once is done once, apart or in a row.
     ("fetch the ball, then look around",
      "approach ball; lookleft 1.5708; perceive; lookright 3.1416; perceive; lookleft 1.5708; approach ball; "
@@ -288,6 +291,9 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     ("look right, then face left", "lookright 0.5236; turnleft 1.5708;"),
     ("look around, only your head", "lookleft 1.5708; perceive; lookright 3.1416; perceive; lookleft 1.5708;"),
     ("go forward only 2 metres", "forward 2;"),
+    # A point said whole asks for going there, whatever verb carries it.
+    ("kindly proceed to the point four comma one", "goto 4, 1;"),
+    ("I need you over at the point three, minus two", "goto 3, -2;"),
     ("peek up a little", "lookup 0.2618;"),
     ("go to the table, look around, and come back to the table",
      "approach table; lookleft 1.5708; perceive; lookright 3.1416; perceive; lookleft 1.5708; approach table;"),
