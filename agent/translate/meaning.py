@@ -54,6 +54,8 @@ _TAKEN_BACK_WORD = re.compile(rf"\b([a-z]+){_CORRECTED}([a-z]+)")
 _CORRECTED_AMOUNT = re.compile(rf"(?<![\w.])(\d*\.?\d+) (m|rad){_CORRECTED}((?:[a-z']+,? ){{0,4}}?)(\d*\.?\d+) \2\b")
 _FIRST_CLAUSE = re.compile(r"[.;]")
 _NEXT_WORD = re.compile(r"\s+([a-z]+)")
+# "would you mind turning left": the "-ing" word after "mind" asks for the act.
+_MIND_DOING = re.compile(r"\bmind ([a-z]{3,}?)ing\b")
 # A point said whole: two numbers joined by a comma ("the point 3, -2").
 _POINT = re.compile(r"(?<![\w.])(-?\d*\.?\d+), (-?\d*\.?\d+)(?![\w.])")
 # Two amounts in one unit with only a comma and a few words between: the second may correct the first
@@ -145,7 +147,7 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
                   ) -> tuple[Doubt, ...]:
     """Every disagreement between the normalized `task` and `plan`; empty when they agree."""
     vocab = _vocabulary(profile)
-    text = task.lower()
+    text = _MIND_DOING.sub(lambda m: f"mind to {_stem(m.group(1), vocab)}", task.lower())
     # A bare "no" before a correction ("left, no, make that right") takes a word back, not the clause.
     negated = " ".join(m.group(0) for m in _NEGATION.finditer(text) if m.group(0).strip() not in MARKERS)
     affirmed = _NEGATION.sub(lambda m: m.group(0) if m.group(0).strip() in MARKERS else " ", text)
@@ -253,6 +255,12 @@ def _points_asked(text: str, plan: Plan, vocab: _Vocabulary) -> set[str]:
                 _close(values[0], x) and _close(values[1], y) for x, y in said):
             found.add(vocab.parts.get(c.skill, WHOLE))
     return found
+
+
+def _stem(stem: str, vocab: _Vocabulary) -> str:
+    """The verb of an "-ing" form with "ing" cut off: "back" (backing), "drive" (driv), "grab" (grabb)."""
+    undoubled = stem[:-1] if stem[-1] == stem[-2] else stem
+    return next((w for w in (stem, undoubled, stem + "e") if w in vocab.known_words), undoubled)
 
 
 def skill_words(profile: Profile) -> frozenset[str]:

@@ -176,6 +176,9 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
      "you asked to move only the head, but the plan moves the base (turn right 90°)"),
     ("the ball rolled forward 2 metres", "forward 2;",
      "you did not ask the robot to move, but the plan does (drive forward 2 m)"),
+    # "mind" asks only for the act its "-ing" word names.
+    ("would you mind looking up?", "forward 1;",
+     "you asked about the head, but the plan moves the base (drive forward 1 m)"),
     # Only the point said asks for the drive there.
     ("proceed to the point 4, 1", "goto 1, 4;",
      "you did not ask the robot to move, but the plan does (drive to the point (1 m, 4 m))"),
@@ -294,6 +297,10 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     # A point said whole asks for going there, whatever verb carries it.
     ("kindly proceed to the point four comma one", "goto 4, 1;"),
     ("I need you over at the point three, minus two", "goto 3, -2;"),
+    # "would you mind" with an "-ing" form asks for the act.
+    ("hey robbie, would you mind backing up two metres?", "backward 2;"),
+    ("mind scooting back a metre? cheers", "backward 1;"),
+    ("would you mind heading over to the till?", "approach till;"),
     ("peek up a little", "lookup 0.2618;"),
     ("go to the table, look around, and come back to the table",
      "approach table; lookleft 1.5708; perceive; lookright 3.1416; perceive; lookleft 1.5708; approach table;"),
