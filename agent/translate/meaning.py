@@ -54,8 +54,9 @@ _TAKEN_BACK_WORD = re.compile(rf"\b([a-z]+){_CORRECTED}([a-z]+)")
 _CORRECTED_AMOUNT = re.compile(rf"(?<![\w.])(\d*\.?\d+) (m|rad){_CORRECTED}((?:[a-z']+,? ){{0,4}}?)(\d*\.?\d+) \2\b")
 _FIRST_CLAUSE = re.compile(r"[.;]")
 _NEXT_WORD = re.compile(r"\s+([a-z]+)")
-# "would you mind turning left": the "-ing" word after "mind" asks for the act.
-_MIND_DOING = re.compile(r"\bmind ([a-z]{3,}?)ing\b")
+# "would you mind turning left", "before grabbing the cup": the "-ing" word after "mind", "before" or
+# "after" asks for the act.
+_MIND_DOING = re.compile(r"\b(mind|before|after) ([a-z]{3,}?)ing\b")
 # A point said whole: two numbers joined by a comma ("the point 3, -2").
 _POINT = re.compile(r"(?<![\w.])(-?\d*\.?\d+), (-?\d*\.?\d+)(?![\w.])")
 # Two amounts in one unit with only a comma and a few words between: the second may correct the first
@@ -147,7 +148,7 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
                   ) -> tuple[Doubt, ...]:
     """Every disagreement between the normalized `task` and `plan`; empty when they agree."""
     vocab = _vocabulary(profile)
-    text = _MIND_DOING.sub(lambda m: f"mind to {_stem(m.group(1), vocab)}", task.lower())
+    text = _MIND_DOING.sub(lambda m: f"{m.group(1)} to {_stem(m.group(2), vocab)}", task.lower())
     # A bare "no" before a correction ("left, no, make that right") takes a word back, not the clause.
     negated = " ".join(m.group(0) for m in _NEGATION.finditer(text) if m.group(0).strip() not in MARKERS)
     affirmed = _NEGATION.sub(lambda m: m.group(0) if m.group(0).strip() in MARKERS else " ", text)

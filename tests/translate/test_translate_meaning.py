@@ -179,6 +179,8 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
     # "mind" asks only for the act its "-ing" word names.
     ("would you mind looking up?", "forward 1;",
      "you asked about the head, but the plan moves the base (drive forward 1 m)"),
+    ("before grabbing the ball, drive up to it", "approach ball;",
+     "you asked about the gripper, but the plan never uses it"),
     # Only the point said asks for the drive there.
     ("proceed to the point 4, 1", "goto 1, 4;",
      "you did not ask the robot to move, but the plan does (drive to the point (1 m, 4 m))"),
@@ -301,6 +303,8 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     ("hey robbie, would you mind backing up two metres?", "backward 2;"),
     ("mind scooting back a metre? cheers", "backward 1;"),
     ("would you mind heading over to the till?", "approach till;"),
+    # So does "before" or "after" with one.
+    ("before grabbing the spoon, drive up to it", "approach spoon; grasp spoon;"),
     ("peek up a little", "lookup 0.2618;"),
     ("go to the table, look around, and come back to the table",
      "approach table; lookleft 1.5708; perceive; lookright 3.1416; perceive; lookleft 1.5708; approach table;"),
