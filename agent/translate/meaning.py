@@ -55,8 +55,8 @@ _CORRECTED_AMOUNT = re.compile(rf"(?<![\w.])(\d*\.?\d+) (m|rad){_CORRECTED}((?:[
 _FIRST_CLAUSE = re.compile(r"[.;]")
 _NEXT_WORD = re.compile(r"\s+([a-z]+)")
 # "would you mind turning left", "before grabbing the cup": the "-ing" word after "mind", "before" or
-# "after" asks for the act.
-_MIND_DOING = re.compile(r"\b(mind|before|after) ([a-z]{3,}?)ing\b")
+# "after" asks for the act. Elsewhere an "-ing" form may tell what was done ("nice job turning left").
+_ASKED_DOING = re.compile(r"\b(mind|before|after) ([a-z]{3,}?)ing\b")
 # A point said whole: two numbers joined by a comma ("the point 3, -2").
 _POINT = re.compile(r"(?<![\w.])(-?\d*\.?\d+), (-?\d*\.?\d+)(?![\w.])")
 # Two amounts in one unit with only a comma and a few words between: the second may correct the first
@@ -148,7 +148,7 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
                   ) -> tuple[Doubt, ...]:
     """Every disagreement between the normalized `task` and `plan`; empty when they agree."""
     vocab = _vocabulary(profile)
-    text = _MIND_DOING.sub(lambda m: f"{m.group(1)} to {_stem(m.group(2), vocab)}", task.lower())
+    text = _ASKED_DOING.sub(lambda m: f"{m.group(1)} to {_stem(m.group(2), vocab)}", task.lower())
     # A bare "no" before a correction ("left, no, make that right") takes a word back, not the clause.
     negated = " ".join(m.group(0) for m in _NEGATION.finditer(text) if m.group(0).strip() not in MARKERS)
     affirmed = _NEGATION.sub(lambda m: m.group(0) if m.group(0).strip() in MARKERS else " ", text)
@@ -259,7 +259,11 @@ def _points_asked(text: str, plan: Plan, vocab: _Vocabulary) -> set[str]:
 
 
 def _stem(stem: str, vocab: _Vocabulary) -> str:
-    """The verb of an "-ing" form with "ing" cut off: "back" (backing), "drive" (driv), "grab" (grabb)."""
+    """The verb of an "-ing" form with "ing" cut off: "back" (backing), "drive" (driv), "grab" (grabb).
+
+    It is read after "to", as a verb starting a clause, so an unlisted verb
+    ("scooting") asks as `_asked_by_unlisted_verbs` reads it.
+    """
     undoubled = stem[:-1] if stem[-1] == stem[-2] else stem
     return next((w for w in (stem, undoubled, stem + "e") if w in vocab.known_words), undoubled)
 
