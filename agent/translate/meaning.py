@@ -115,7 +115,7 @@ class _Vocabulary:
     conventions: tuple[_Convention, ...]
     coordinates: frozenset[str]  # skills whose numbers are positions, not amounts
     skill_words: frozenset[str]  # keywords, aliases and direction words: never an object's name
-    part_nouns: frozenset[str]  # the nouns of the robot's description ("head", "camera")
+    noun_parts: dict[str, str]  # a noun of the robot's description ("camera") -> its part ("head")
     opposites: dict[str, str]  # skill keyword -> its opposite, both ways
     step_words: dict[str, frozenset[str]]  # skill keyword -> the words that ask for that step
     way_skills: dict[str, frozenset[str]]  # way ("left") -> the skills that go it (turnleft, lookleft)
@@ -125,7 +125,6 @@ class _Vocabulary:
     # The first word of a whole command that is no skill's word ("face" of "face behind") -> the parts
     # its program moves.
     command_verbs: dict[str, frozenset[str]]
-    noun_parts: dict[str, str]  # a part's noun ("camera") -> its part ("head")
 
 
 @dataclass(frozen=True)
@@ -190,7 +189,7 @@ def _words(text: str, vocab: _Vocabulary) -> set[str]:
     ahead"), not that the robot drives.
     """
     tokens = _WORD.findall(text)
-    verbs = Counter(m.group(1) for m in _CLAUSE_START.finditer(text) if m.group(1) in vocab.part_nouns)
+    verbs = Counter(m.group(1) for m in _CLAUSE_START.finditer(text) if m.group(1) in vocab.noun_parts)
     said = Counter(t for t, how in zip(tokens, _ways_of_parts(tokens, vocab), strict=True) if not how)
     return ({t for t in said if verbs[t] < said[t]} | ({WHOLE} if verbs else set())
             | {a + b for a, b in itertools.pairwise(tokens) if a + b in vocab.skill_words})
@@ -395,13 +394,12 @@ def _build_vocabulary(profile: Profile) -> _Vocabulary:
     return _Vocabulary(parts=parts, part_words=part_words, directions=tuple(ways),
                        convention_numbers={u: frozenset(v) for u, v in numbers.items()},
                        conventions=tuple(conventions), coordinates=coordinates,
-                       skill_words=skill_word_set, part_nouns=frozenset(nouns), opposites=opposites,
+                       skill_words=skill_word_set, noun_parts=nouns, opposites=opposites,
                        step_words=step_words, way_skills={w: frozenset(k) for w, k in way_skills.items()},
                        part_verbs=frozenset(w for p, ws in part_words.items() if p != WHOLE for w in ws) - set(nouns),
                        known_words=known_words,
                        way_and_amount=re.compile(rf"\s+([a-z]+)\s+(?:\d*\.?\d+|{amount_phrases})\b"),
-                       command_verbs={w: frozenset(ps) for w, ps in command_verbs.items()},
-                       noun_parts=nouns)
+                       command_verbs={w: frozenset(ps) for w, ps in command_verbs.items()})
 
 
 _VOCABULARIES: dict[tuple[str, str], _Vocabulary] = {}
@@ -625,7 +623,7 @@ def _restated(text: str, plan: Plan, vocab: _Vocabulary, profile: Profile) -> li
     found = [(m, False) for m in _RESTATED.finditer(text)] + [(m, True) for m in _CORRECTED_AMOUNT.finditer(text)]
     for m, marked in found:
         between = set(_WORD.findall(m.group(3)))
-        if between & _SEQUENCE_WORDS or (not marked and between & (vocab.skill_words | vocab.part_nouns)):
+        if between & _SEQUENCE_WORDS or (not marked and between & (vocab.skill_words | vocab.noun_parts.keys())):
             continue
         first, second, unit = float(m.group(1)), float(m.group(4)), m.group(2)
         for a, b in itertools.pairwise(plan):
