@@ -156,4 +156,5 @@ def test_a_stop_while_the_robot_moves_needs_no_wake_word_and_starts_nothing(mic,
         speech.guard(False)  # standing still: a bare stop word is not for the robot
         mic.play(say("멈춰"))
         time.sleep(2.0)
-        assert collector.transcripts.empty()
+        assert collector.transcripts.empty(), \
+            (collector.transcripts.get(), [(e.kind, e.detail) for e in collector.events])
