@@ -21,9 +21,10 @@ from rsl.profile import Profile
 # What one disagreement between task and plan leaves of the confidence: any one of them is a likely
 # wrong program, so a single doubt puts the plan below UNSURE_BELOW however sure the model was.
 DOUBT_FACTOR = 0.3
-# The default `confirm = "unsure"` policy asks below this. Chosen on the evaluation suite
-# (agent/evalsuite/suite.toml): see bench/bench_confidence.py and docs/translate.md.
-UNSURE_BELOW = 0.5
+# The default `confirm = "unsure"` policy asks below this: the lowest threshold at which, over the fourteen
+# fresh sets the checks are judged on, at most 2 in 100 items run a wrong program unasked and at most 10 % of
+# right programs are questioned (bench/bench_confidence.py's coverage curves; docs/confidence.md).
+UNSURE_BELOW = 0.7
 POLICIES = ("never", "unsure", "always")
 
 

@@ -12,6 +12,7 @@ from typing import Any
 import pytest
 
 from agent.client import Client, RequestFailed
+from agent.translate.confidence import UNSURE_BELOW
 from tests.daemon.conftest import Daemon, check_frame, follow
 
 TIMEOUT_S = 3.0
@@ -104,7 +105,7 @@ def test_under_the_default_policy_only_an_unsure_task_waits(daemon: Daemon) -> N
             names = [e["event"] for e in follow(client, task)]
             assert "confirm" not in names and names[-1] == "done", names
             task, question, before = _asked(client, UNSURE)
-            assert question["confidence"] < 0.5 and question["reasons"], question
+            assert question["confidence"] < UNSURE_BELOW and question["reasons"], question
             _accepted_and_run(client, task, before)
     finally:
         daemon.config_file.write_text(text.replace('confirm = "unsure"', 'confirm = "always"'), encoding="utf-8")

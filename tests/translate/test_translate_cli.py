@@ -10,6 +10,8 @@ from pathlib import Path
 
 import pytest
 
+from agent.translate.confidence import UNSURE_BELOW
+
 NRTRANS = [sys.executable, "-m", "agent.cli"]
 
 
@@ -27,7 +29,7 @@ def test_json_contract_and_exit_zero_when_verified(model_path: Path) -> None:
     assert data["verified"] is True and data["task"] == "grasp the cup"
     assert data["plan"] and all("skill" in c for c in data["plan"])
     assert data["explanation"] == "pick up the cup" and 0 <= data["confidence"] <= 1
-    assert data["confirm"] is (data["confidence"] < 0.5) and data["refused"] is False
+    assert data["confirm"] is (data["confidence"] < UNSURE_BELOW) and data["refused"] is False
     plain = _run("translate", "--model", str(model_path), "--objects", "cup", "grasp the cup")
     assert plain.stdout == data["program"] and "-> pick up the cup" in plain.stderr
 
