@@ -81,16 +81,16 @@ def main() -> None:
         "wake": [wake, *(f"{wake} {s}" for s in stops), *(f"{wake} {c}" for c in commands)],
         "other": [*stops, *commands, *OTHER_SPEECH[args.language]],
     }
-    rows: dict[str, list[dict[str, object]]] = {}
+    woke: dict[str, dict[str, int]] = {name: {} for name in sets}
     with tempfile.TemporaryDirectory() as tmp:
         for name, texts in sets.items():
-            rows[name] = []
             for index, text in enumerate(texts):
                 audio = resample(synthesise(text, VOICES[args.language], Path(tmp), index), MODEL_RATE)
-                rows[name].append({"text": text, "woke": wakes(model, grammar, wake, audio, args.alignments)})
-                print(f"{name}: {text!r} woke at {rows[name][-1]['woke']} of {args.alignments}", flush=True)
-    totals = {name: {"woke": sum(int(str(r["woke"])) for r in found), "tries": len(found) * args.alignments}
-              for name, found in rows.items()}
+                woke[name][text] = wakes(model, grammar, wake, audio, args.alignments)
+                print(f"{name}: {text!r} woke at {woke[name][text]} of {args.alignments}", flush=True)
+    totals = {name: {"woke": sum(found.values()), "tries": len(found) * args.alignments}
+              for name, found in woke.items()}
+    rows = {name: [{"text": text, "woke": count} for text, count in found.items()] for name, found in woke.items()}
     report = {
         "what": "wake-spotter hits on wake phrases and false wakes on other speech, espeak-ng, 0.1 s blocks",
         "model": args.model, "language": args.language, "wake_word": wake, "alignments": args.alignments,
