@@ -545,7 +545,7 @@ class Translator:
 
 # Below this first-token probability the adapter is guessing. On the evaluation suite and the new
 # phrasings (207 clauses) the lowest was 0.78, on 18 chit-chat lines the median 0.6 (bench_eval's sets).
-UNSURE_BELOW = 0.5
+GUESSING_BELOW = 0.5
 
 
 def _end_where_weighed(state: _ClauseState, text: str) -> None:
@@ -573,7 +573,7 @@ def _reads_as_task(generation: Generation, profile: Profile) -> bool:
     piece = generation.first_piece.strip()
     starts_rsl = bool(piece) and any(s.keyword.startswith(piece) or piece.startswith(s.keyword)
                                      for s in profile.skills)
-    return starts_rsl and generation.first_probability >= UNSURE_BELOW
+    return starts_rsl and generation.first_probability >= GUESSING_BELOW
 
 
 def _likely_meant(names: Collection[str], known: Collection[str]) -> tuple[str, ...]:
