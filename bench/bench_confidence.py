@@ -11,7 +11,9 @@ Writes aggregates only:
 - auroc: how well the confidence ranks right plans above wrong ones (verified plans only);
 - coverage_curve: accuracy of the plans kept when only those at or above a confidence are run;
 - questioned_by: for right and wrong plans the policy questions, how many each meaning check doubted;
-- checks_ms p50/p95: the added time of the meaning checks, explanation and confidence per translation.
+- checks_ms p50/p95: the added time of the meaning checks, explanation and confidence per translation;
+- guessing_curve: what the first-token check (E201) would give at other thresholds than GUESSING_BELOW. Exact,
+  not a model: that check reads only the first pass's first token, before anything else can differ.
 
     python bench/bench_confidence.py [--suite FILE] [--out FILE] [--every K]
 
@@ -39,6 +41,8 @@ from agent.evalsuite.suite import accepts, suite_path
 from agent.normalize import normalize_task
 from agent.translate import Translator
 from agent.translate.confidence import UNSURE_BELOW, assess, result_fields
+from agent.translate.engine import Generation
+from agent.translate.translator import GUESSING_BELOW, task_reading
 from bench import SPLIT
 from rsl.profile import load_profile
 
@@ -60,6 +64,29 @@ def questioned_by(rows: list[dict[str, Any]]) -> dict[str, int]:
     return dict(sorted(counted.items()))
 
 
+def guessing_curve(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """For first-token thresholds at and above GUESSING_BELOW, the outcomes if clauses the model started
+    less surely than that had been refused as non-tasks too."""
+    curve = []
+    for step in range(round(GUESSING_BELOW * 20), 20):
+        threshold = step / 20
+        outcome = []
+        for row in rows:
+            reading = row["first_reading"]
+            if reading is not None and reading < threshold:
+                row = {**row, "verified": False, "right": False, "confirm": False, "refused": True}
+            outcome.append(row)
+        tasks = [r for r in outcome if not r["refuse"]]
+        right = [r for r in outcome if r["verified"] and r["right"]]
+        curve.append({"threshold": threshold,
+                      "non_tasks_without_program": sum(1 for r in outcome if r["refuse"] and not r["verified"]),
+                      "tasks_refused": sum(1 for r in tasks if r["refused"]),
+                      "right_programs": len(right), "right_questioned": sum(1 for r in right if r["confirm"]),
+                      "wrong_runs_unasked": sum(1 for r in outcome
+                                                if r["verified"] and not r["right"] and not r["confirm"])})
+    return curve
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--suite", metavar="FILE", help="suite file (default: the evaluation suite)")
@@ -77,10 +104,21 @@ def main() -> int:
     tasks = load_suite(args.suite, profile)[:: max(1, args.every)]
     translator = Translator.load(profile, adapter=args.adapter,
                                  split_clauses=SPLIT[args.split])
+    # The first pass's first generation of each translation: the one the first-token check reads.
+    firsts: list[Generation] = []
+    generate = translator.engine.generate
+
+    def recording(*args: Any, **kwargs: Any) -> Generation:
+        generation = generate(*args, **kwargs)
+        firsts.append(generation)
+        return generation
+
+    translator.engine.generate = recording  # type: ignore[method-assign]
     rows: list[dict[str, Any]] = []
     checks_ms: list[float] = []
     started = time.monotonic()
     for index, task in enumerate(tasks, 1):
+        firsts.clear()
         result = translator.translate(task.task, known_objects=task.objects)
         checks: list[str] = []
         if result.plan is not None:
@@ -94,6 +132,8 @@ def main() -> int:
                      "verified": result.verified, "right": accepts(task, result.plan, profile),
                      "confidence": result.confidence, "confirm": result.confirm, "refused": result.refused,
                      "doubts": list(result.doubts), "checks": checks,
+                     "first_reading": (task_reading(firsts[0], profile)
+                                       if firsts and translator.options.refuse_unclear else None),
                      "total_ms": result.timings_ms.get("total", 0.0)})
         print(f"\r{index}/{len(tasks)} {time.monotonic() - started:.0f} s", end="", file=sys.stderr, flush=True)
     print(file=sys.stderr)
@@ -134,6 +174,7 @@ def main() -> int:
                            for group in dict.fromkeys(r["group"] for r in rows)},
         "auroc": auroc([r["confidence"] for r in right], [r["confidence"] for r in wrong]),
         "coverage_curve": curve,
+        "guessing_below": GUESSING_BELOW, "guessing_curve": guessing_curve(rows),
         "checks_ms_p50": percentile(checks_ms, 0.5), "checks_ms_p95": percentile(checks_ms, 0.95),
         "translate_ms_p50": percentile([r["total_ms"] for r in rows], 0.5),
         "machine": {"cpus": os.cpu_count(), "load_avg": os.getloadavg(), "python": platform.python_version(),
@@ -145,7 +186,8 @@ def main() -> int:
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
-    print(json.dumps({k: v for k, v in summary.items() if k not in ("per_task", "coverage_curve")}, indent=2))
+    curves = ("per_task", "coverage_curve", "guessing_curve")
+    print(json.dumps({k: v for k, v in summary.items() if k not in curves}, indent=2))
     return 0
 
 

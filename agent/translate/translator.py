@@ -566,14 +566,21 @@ def _end_where_weighed(state: _ClauseState, text: str) -> None:
                    "weighed ending at p=%.2f", count, probability)
 
 
-def _reads_as_task(generation: Generation, profile: Profile) -> bool:
-    """Whether the model, free of the grammar, would start an RSL statement, and is sure enough of it."""
+def task_reading(generation: Generation, profile: Profile) -> float | None:
+    """How sure the model, free of the grammar, is that it starts an RSL statement: its first choice's
+    probability when that begins a skill keyword, 0 when it begins anything else; None: the engine cannot tell."""
     if generation.first_probability is None:
-        return True
+        return None
     piece = generation.first_piece.strip()
     starts_rsl = bool(piece) and any(s.keyword.startswith(piece) or piece.startswith(s.keyword)
                                      for s in profile.skills)
-    return starts_rsl and generation.first_probability >= GUESSING_BELOW
+    return generation.first_probability if starts_rsl else 0.0
+
+
+def _reads_as_task(generation: Generation, profile: Profile) -> bool:
+    """Whether the model would start an RSL statement, and is sure enough of it."""
+    reading = task_reading(generation, profile)
+    return reading is None or reading >= GUESSING_BELOW
 
 
 def _likely_meant(names: Collection[str], known: Collection[str]) -> tuple[str, ...]:
