@@ -13,7 +13,8 @@ Writes aggregates only:
 - questioned_by: for right and wrong plans the policy questions, how many each meaning check doubted;
 - checks_ms p50/p95: the added time of the meaning checks, explanation and confidence per translation;
 - guessing_curve: what the first-token check (E201) would give at other thresholds than GUESSING_BELOW. Exact,
-  not a model: that check reads only the first pass's first token, before anything else can differ.
+  not a model: that check reads only the first pass's first token, before anything else can differ;
+- doubted_guessing_curve: the same, refusing only plans a meaning check doubts.
 
     python bench/bench_confidence.py [--suite FILE] [--out FILE] [--every K]
 
@@ -64,16 +65,17 @@ def questioned_by(rows: list[dict[str, Any]]) -> dict[str, int]:
     return dict(sorted(counted.items()))
 
 
-def guessing_curve(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """For first-token thresholds at and above GUESSING_BELOW, the outcomes if clauses the model started
-    less surely than that had been refused as non-tasks too."""
+def guessing_curve(rows: list[dict[str, Any]], *, doubted_only: bool = False) -> list[dict[str, Any]]:
+    """For first-token thresholds from GUESSING_BELOW to 1, the outcomes if clauses the model started less
+    surely than that had been refused as non-tasks too; with `doubted_only`, only those whose plan a meaning
+    check doubts."""
     curve = []
-    for step in range(round(GUESSING_BELOW * 20), 20):
+    for step in range(round(GUESSING_BELOW * 20), 21):
         threshold = step / 20
         outcome = []
         for row in rows:
             reading = row["first_reading"]
-            if reading is not None and reading < threshold:
+            if reading is not None and reading < threshold and (row["checks"] or not doubted_only):
                 row = {**row, "verified": False, "right": False, "confirm": False, "refused": True}
             outcome.append(row)
         tasks = [r for r in outcome if not r["refuse"]]
@@ -175,6 +177,7 @@ def main() -> int:
         "auroc": auroc([r["confidence"] for r in right], [r["confidence"] for r in wrong]),
         "coverage_curve": curve,
         "guessing_below": GUESSING_BELOW, "guessing_curve": guessing_curve(rows),
+        "doubted_guessing_curve": guessing_curve(rows, doubted_only=True),
         "checks_ms_p50": percentile(checks_ms, 0.5), "checks_ms_p95": percentile(checks_ms, 0.95),
         "translate_ms_p50": percentile([r["total_ms"] for r in rows], 0.5),
         "machine": {"cpus": os.cpu_count(), "load_avg": os.getloadavg(), "python": platform.python_version(),
@@ -186,7 +189,7 @@ def main() -> int:
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
-    curves = ("per_task", "coverage_curve", "guessing_curve")
+    curves = ("per_task", "coverage_curve", "guessing_curve", "doubted_guessing_curve")
     print(json.dumps({k: v for k, v in summary.items() if k not in curves}, indent=2))
     return 0
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Iterator
 
 import pytest
 
@@ -89,3 +90,49 @@ def test_without_the_option_the_grammar_forces_a_program(translator: Translator)
     plain = Translator(translator.profile, engine, translator.model_name, options)  # type: ignore[arg-type]
     result = plain.translate("what time is it")
     assert NO_PROGRAM not in result.program
+
+
+class _FirstReadingEngine:
+    """The real engine, reporting the model's free first choice as `forward`, `probability` sure: the
+    first-token reading a task gets varies with the CPU's arithmetic, so the test sets it."""
+
+    def __init__(self, engine: object, probability: float) -> None:
+        self.engine = engine
+        self.probability = probability
+        self.chat_template = getattr(engine, "chat_template", "")
+
+    def generate(self, prompt: str, automaton: RslAutomaton | None, max_tokens: int,
+                 cancel: CancelFlag | None = None, fork: Fork | None = None) -> Generation:
+        generation = self.engine.generate(prompt, automaton, max_tokens, cancel, fork=fork)  # type: ignore[attr-defined]
+        return dataclasses.replace(generation, first_piece="forward", first_probability=self.probability)
+
+    def close(self) -> None:
+        """The wrapped engine belongs to the module's fixture."""
+
+
+@pytest.fixture(scope="module")
+def adapted(profile: Profile) -> Iterator[Translator]:
+    loaded = Translator.load(profile)
+    yield loaded
+    loaded.close()
+
+
+def test_a_doubted_plan_the_model_guessed_at_is_refused_as_no_task(adapted: Translator) -> None:
+    from agent.translate.translator import DOUBTED_GUESS_BELOW, GUESSING_BELOW
+
+    task = "The water bottle is two meters in front of you."
+    results = {}
+    for probability in (GUESSING_BELOW + 0.01, DOUBTED_GUESS_BELOW - 0.01, DOUBTED_GUESS_BELOW + 0.01):
+        engine = _FirstReadingEngine(adapted.engine, probability)
+        results[probability] = Translator(adapted.profile, engine, adapted.model_name,  # type: ignore[arg-type]
+                                          adapted.options).translate(task)
+    sure = results[DOUBTED_GUESS_BELOW + 0.01]
+    # The shipped adapter drives 2 m for it, and the meaning checks doubt that: asked, not refused.
+    assert sure.verified and sure.confirm and sure.doubts, sure
+    for probability in (GUESSING_BELOW + 0.01, DOUBTED_GUESS_BELOW - 0.01):
+        guessed = results[probability]
+        assert not guessed.verified and guessed.plan is None and guessed.refused and guessed.passes == 1
+        (diagnostic,) = guessed.attempts[-1].diagnostics
+        assert diagnostic.code is Code.NOT_A_TASK
+        assert f"the model was {probability:.0%} sure it was one" in diagnostic.message
+        assert sure.doubts[0] in diagnostic.message
