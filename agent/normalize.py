@@ -329,7 +329,8 @@ def _convert_numbers(tokens: list[str]) -> list[str]:
             continue
         if token in ("twice", "thrice"):
             out.append("2 times" if token == "twice" else "3 times")
-        elif token == "comma" and out and _is_number_token(out[-1]) and _parse_number(tokens, i + 1) is not None:
+        elif token == "comma" and out and _is_number_token(out[-1]) and (
+                _parse_number(tokens, i + 1) is not None or (i + 1 < len(tokens) and _in_point(tokens, i + 1))):
             # A comma said between two numbers, as a recognizer writes coordinates.
             out.append(",")
         else:
@@ -345,6 +346,27 @@ def _coordinates_at(tokens: Sequence[str], i: int) -> int | None:
         return None
     second = _parse_number(tokens, first[1] + 1)
     return None if second is None else second[1]
+
+
+# The words that put a point right before its coordinates ("the point for comma one", "at too, for").
+_POINT_WORDS = frozenset({"point", "at", "to", "coordinates", "position", "location"})
+# What may follow a point's second coordinate: the end of its clause.
+_CLAUSE_ENDS = frozenset({",", ".", "and", "then", "please"})
+
+
+def _in_point(tokens: Sequence[str], i: int) -> bool:
+    """Whether the homophone at tokens[i] is one of two numbers said as a point right after a word that
+    names one: "the point for comma one", "go to two, for". A recognizer spells a number that way wherever
+    one is said, not only before a unit; "look for, 2 cups" and "go to 1, for the cup" stay words."""
+    def number_at(k: int) -> bool:
+        return 0 <= k < len(tokens) and (tokens[k] in _HOMOPHONES or _parse_number(tokens, k) is not None)
+
+    comma = (",", "comma")
+    first = (i >= 1 and tokens[i - 1] in _POINT_WORDS and i + 2 < len(tokens) and tokens[i + 1] in comma
+             and number_at(i + 2))
+    second = (i >= 3 and tokens[i - 1] in comma and number_at(i - 2) and tokens[i - 3] in _POINT_WORDS
+              and (i + 1 == len(tokens) or tokens[i + 1] in _CLAUSE_ENDS))
+    return first or second
 
 
 def _u_turn_at(tokens: Sequence[str], i: int) -> int | None:
@@ -379,6 +401,8 @@ def _convert_at(tokens: list[str], i: int) -> tuple[str, int] | None:
         return format_number(value), j
     if token in _HOMOPHONES:
         nxt = tokens[i + 1] if i + 1 < len(tokens) else ""
+        if _in_point(tokens, i):
+            return format_number(_HOMOPHONES[token]), i + 1
         if nxt == "times" or _unit_at(tokens, i + 1) is not None or _revolutions_at(tokens, i + 1):
             value = float(_HOMOPHONES[token])
             unit = _with_unit(tokens, value, i + 1, explicit=True)

@@ -37,6 +37,13 @@ from agent.normalize import normalize_task
         # Two numbers after "point" are a place, as a recognizer writes it, comma and all.
         ("er go to point three comma minus two", "go to point 3, -2"),
         ("go to two comma three", "go to 2, 3"),
+        # A recognizer's homophone of a number is one in a point, right after a word naming the place ...
+        ("drive to the point for comma one", "drive to the point 4, 1"),
+        ("head to the spot at too comma for", "head to the spot at 2, 4"),
+        ("go to point for comma too and then grab the cup", "go to point 4, 2 and then grab the cup"),
+        # ... and stays a word elsewhere, next to a comma or not.
+        ("look for, 2 cups", "look for, 2 cups"),
+        ("go to 1, for the cup", "go to 1, for the cup"),
         ("drive point five meters, and then turn", "drive 0.5 m, and then turn"),
         ("do one complete rotation", "do 6.2832 rad"),
         ("spin a whole turn", "spin 6.2832 rad"),
