@@ -22,3 +22,11 @@ def translator(profile: Profile, model_path: Path) -> Iterator[Translator]:
     loaded = Translator.load(profile, model=str(model_path))
     yield loaded
     loaded.close()
+
+
+@pytest.fixture(scope="session")
+def adapted(profile: Profile) -> Iterator[Translator]:
+    """The embedded model with the shipped adapter, as `nrtrans translate` loads it by default."""
+    loaded = Translator.load(profile)
+    yield loaded
+    loaded.close()

@@ -3,10 +3,6 @@ whole program fails a meaning check."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-
-import pytest
-
 from agent.normalize import normalize_task
 from agent.translate import Translator
 from agent.translate.automaton import RslAutomaton
@@ -14,7 +10,6 @@ from agent.translate.clauses import Clause
 from agent.translate.confidence import UNSURE_BELOW
 from agent.translate.engine import Fork
 from agent.translate.translator import ENDING_FLOOR, FORK_FLOOR, _ClauseState, _end_where_weighed
-from rsl.profile import Profile
 
 SQUARE_SIDE = "forward 1;\nturnleft 1.5708;\n"
 
@@ -128,13 +123,6 @@ def test_another_choice_that_also_fails_the_checks_is_not_taken(translator: Tran
     timings = {"prompt": 0.0, "generate": 0.0}
     found = translator._other_choice(state, state.clause.text, None, None, timings)
     assert found is None and timings["prompt"] + timings["generate"] > 0
-
-
-@pytest.fixture(scope="module")
-def adapted(profile: Profile) -> Iterator[Translator]:
-    loaded = Translator.load(profile)
-    yield loaded
-    loaded.close()
 
 
 def test_a_program_the_token_cap_cut_off_ends_where_the_model_weighed_ending(adapted: Translator) -> None:

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Iterator
 
 import pytest
 
@@ -108,13 +107,6 @@ class _FirstReadingEngine:
 
     def close(self) -> None:
         """The wrapped engine belongs to the module's fixture."""
-
-
-@pytest.fixture(scope="module")
-def adapted(profile: Profile) -> Iterator[Translator]:
-    loaded = Translator.load(profile)
-    yield loaded
-    loaded.close()
 
 
 def test_a_doubted_plan_the_model_guessed_at_is_refused_as_no_task(adapted: Translator) -> None:
