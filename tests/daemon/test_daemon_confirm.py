@@ -17,9 +17,9 @@ from tests.daemon.conftest import Daemon, check_frame, follow
 
 TIMEOUT_S = 3.0
 TASK = "drive forward 0.3 meters"
-# Speech-recognizer noise for "turn right four times": the shipped adapter writes `turnright 4;` four
-# times, a plan the meaning checks doubt (an angle never said, 917 degrees in all); if a retrained adapter
-# gets it right, pick another phrase it gets wrong.
+# Speech-recognizer noise for "turn right four times": the shipped adapter writes four quarter turns, but
+# is only about 31 % sure of its words (2026-11-27), so the default policy asks; if a retrained adapter
+# is sure of it, pick another phrase it is unsure of (the test below checks it is unsure).
 UNSURE = "turn right for times"
 NOT_A_TASK = "thank you, that is all for today"
 
