@@ -330,7 +330,7 @@ def _convert_numbers(tokens: list[str]) -> list[str]:
         if token in ("twice", "thrice"):
             out.append("2 times" if token == "twice" else "3 times")
         elif token == "comma" and out and _is_number_token(out[-1]) and (
-                _parse_number(tokens, i + 1) is not None or (i + 1 < len(tokens) and _in_point(tokens, i + 1))):
+                _parse_number(tokens, i + 1) is not None or _in_point(tokens, i + 1)):
             # A comma said between two numbers, as a recognizer writes coordinates.
             out.append(",")
         else:
@@ -355,12 +355,14 @@ _CLAUSE_ENDS = frozenset({",", ".", "and", "then", "please"})
 
 
 def _in_point(tokens: Sequence[str], i: int) -> bool:
-    """Whether the homophone at tokens[i] is one of two numbers said as a point right after a word that
-    names one: "the point for comma one", "go to two, for". A recognizer spells a number that way wherever
-    one is said, not only before a unit; "look for, 2 cups" and "go to 1, for the cup" stay words."""
+    """Whether tokens[i] is a homophone of a number and one of two numbers said as a point right after a
+    word that names one: "the point for comma one", "go to two, for". A recognizer spells a number that way
+    wherever one is said, not only before a unit; "look for, 2 cups" and "go to 1, for the cup" stay words."""
     def number_at(k: int) -> bool:
         return 0 <= k < len(tokens) and (tokens[k] in _HOMOPHONES or _parse_number(tokens, k) is not None)
 
+    if i >= len(tokens) or tokens[i] not in _HOMOPHONES:
+        return False
     comma = (",", "comma")
     first = (i >= 1 and tokens[i - 1] in _POINT_WORDS and i + 2 < len(tokens) and tokens[i + 1] in comma
              and number_at(i + 2))

@@ -44,6 +44,7 @@ from agent.normalize import normalize_task
         # ... and stays a word elsewhere, next to a comma or not.
         ("look for, 2 cups", "look for, 2 cups"),
         ("go to 1, for the cup", "go to 1, for the cup"),
+        ("go to 3 comma x", "go to 3 comma x"),
         ("drive point five meters, and then turn", "drive 0.5 m, and then turn"),
         ("do one complete rotation", "do 6.2832 rad"),
         ("spin a whole turn", "spin 6.2832 rad"),
