@@ -234,7 +234,7 @@ class Translator:
                                generation.generate_ms)
                 if self.options.refuse_unclear and not attempts:
                     state.reading = task_reading(generation, self.profile)
-                    if state.reading is not None and state.reading < GUESSING_BELOW:
+                    if not _sure_it_is_a_task(state.reading):
                         state.unclear = (generation.first_piece, generation.first_probability or 0.0)
             program = _assemble(states)
             compile_started = time.perf_counter()
@@ -512,20 +512,23 @@ class Translator:
         water bottle is two meters in front of you" as a 2 m drive), and a question about such a plan
         would put a motion to someone who never asked for one.
         """
-        readings = [s.reading for s in states if s.reading is not None]
-        if not doubts or not readings or min(readings) >= DOUBTED_GUESS_BELOW:
+        read = [s for s in states if s.reading is not None]
+        if not doubts or not read:
             return None
-        state = min((s for s in states if s.reading is not None), key=lambda s: s.reading or 0.0)
-        return self._not_a_task(state, f"the model was {state.reading:.0%} sure it was one, and "
-                                       f"{doubts[0].reason}")
+        state = min(read, key=lambda s: s.reading or 0.0)
+        reading = state.reading or 0.0
+        if reading >= DOUBTED_GUESS_BELOW:
+            return None
+        return self._not_a_task(state, f"the model was {reading:.0%} sure it was one, and {doubts[0].reason}")
 
     def _not_a_task(self, state: _ClauseState, reason: str | None = None) -> Diagnostic:
-        if reason is None and state.refused:
-            reason = "the model wrote that it has no program for it"
-        elif reason is None:
-            assert state.unclear is not None
-            piece, probability = state.unclear
-            reason = f"the model would begin with {piece.strip()!r}, {probability:.0%} sure"
+        if reason is None:
+            if state.refused:
+                reason = "the model wrote that it has no program for it"
+            else:
+                assert state.unclear is not None
+                piece, probability = state.unclear
+                reason = f"the model would begin with {piece.strip()!r}, {probability:.0%} sure"
         written = state.program.splitlines()[0] if state.program.strip() else ""
         examples = " or ".join(f"'{c.task}'" for c in self.profile.conventions[:2] if c.task)
         return Diagnostic(
@@ -603,9 +606,8 @@ def task_reading(generation: Generation, profile: Profile) -> float | None:
     return generation.first_probability if starts_rsl else 0.0
 
 
-def _reads_as_task(generation: Generation, profile: Profile) -> bool:
-    """Whether the model would start an RSL statement, and is sure enough of it."""
-    reading = task_reading(generation, profile)
+def _sure_it_is_a_task(reading: float | None) -> bool:
+    """Whether a `task_reading` is sure enough; an engine that cannot tell refuses nothing."""
     return reading is None or reading >= GUESSING_BELOW
 
 

@@ -186,18 +186,21 @@ def test_an_adapter_for_another_prompt_format_is_refused(profile: Profile, tmp_p
 
 def test_a_clause_reads_as_a_task_when_the_model_would_start_rsl_and_is_sure(profile: Profile) -> None:
     from agent.translate.engine import Generation
-    from agent.translate.translator import GUESSING_BELOW, _reads_as_task, task_reading
+    from agent.translate.translator import GUESSING_BELOW, _sure_it_is_a_task, task_reading
 
     def first(piece: str, probability: float | None) -> Generation:
         return Generation(text="", prompt_tokens=1, reused_tokens=0, generated_tokens=0, prompt_ms=0.0,
                           generate_ms=0.0, finished=True, first_piece=piece, first_probability=probability)
 
-    assert _reads_as_task(first("forward", 0.99), profile)
-    assert _reads_as_task(first("look", 0.9), profile)  # a piece of `lookleft`
-    assert not _reads_as_task(first("sing", 0.99), profile)  # the model wants to write something else
-    assert not _reads_as_task(first("turn", GUESSING_BELOW / 2), profile)  # a guess
-    assert not _reads_as_task(first("", 0.99), profile)  # it would end at once
-    assert _reads_as_task(first("", None), profile)  # an engine that cannot tell refuses nothing
+    def reads_as_task(generation: Generation) -> bool:
+        return _sure_it_is_a_task(task_reading(generation, profile))
+
+    assert reads_as_task(first("forward", 0.99))
+    assert reads_as_task(first("look", 0.9))  # a piece of `lookleft`
+    assert not reads_as_task(first("sing", 0.99))  # the model wants to write something else
+    assert not reads_as_task(first("turn", GUESSING_BELOW / 2))  # a guess
+    assert not reads_as_task(first("", 0.99))  # it would end at once
+    assert reads_as_task(first("", None))  # an engine that cannot tell refuses nothing
     assert task_reading(first("turn", 0.6), profile) == 0.6
     assert task_reading(first("sing", 0.99), profile) == 0.0
     assert task_reading(first("", None), profile) is None
