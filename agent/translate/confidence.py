@@ -62,6 +62,12 @@ def assess(task: str, plan: Plan, profile: Profile, *, model: float | None = Non
     return Assessment(confidence=round(min(1.0, max(0.0, confidence)), 4), doubts=doubts, model=model)
 
 
+def with_doubt(assessment: Assessment, doubt: Doubt) -> Assessment:
+    """`assessment` with one more doubt, its confidence cut as `assess` cuts it for each."""
+    confidence = round(max(0.0, assessment.confidence * DOUBT_FACTOR), 4)
+    return Assessment(confidence=confidence, doubts=(*assessment.doubts, doubt), model=assessment.model)
+
+
 def asks(policy: str, assessment: Assessment | None) -> bool:
     """Whether `policy` asks the person before the plan runs."""
     if policy == "always":
@@ -71,14 +77,8 @@ def asks(policy: str, assessment: Assessment | None) -> bool:
     return assessment is not None and assessment.unsure
 
 
-def judge(task: str, plan: Plan, profile: Profile, probabilities: Iterable[float],
-          known_objects: Collection[str] | None = None) -> dict[str, Any]:
-    """The fields a verified `TranslationResult` carries besides the plan: explanation, confidence, doubts."""
-    assessment = assess(task, plan, profile, model=model_signal(probabilities), known_objects=known_objects)
-    return result_fields(plan, profile, assessment)
-
-
 def result_fields(plan: Plan, profile: Profile, assessment: Assessment) -> dict[str, Any]:
-    """`judge`'s fields for a plan already assessed."""
+    """The fields a verified `TranslationResult` carries besides the plan: explanation, confidence, doubts."""
     return {"explanation": explain(plan, profile), "confidence": assessment.confidence,
-            "doubts": assessment.reasons, "confirm": asks("unsure", assessment)}
+            "doubts": assessment.reasons, "doubted_by": tuple(d.check for d in assessment.doubts),
+            "confirm": asks("unsure", assessment)}

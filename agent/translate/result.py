@@ -42,6 +42,8 @@ class TranslationResult:
     confidence: float | None = None
     # Why it is unsure, one reason a person can read per entry.
     doubts: tuple[str, ...] = ()
+    # The meaning checks behind `doubts`, one name each ("part", "whole"), for measuring them.
+    doubted_by: tuple[str, ...] = ()
     # Whether the default policy (`confirm = "unsure"`) asks before the plan runs.
     confirm: bool = False
 

@@ -23,8 +23,9 @@ from agent.adapter.card import AdapterCard, card_path, read_card
 from agent.normalize import normalize_task
 from agent.translate.automaton import RslAutomaton
 from agent.translate.clauses import Clause, split_clauses
-from agent.translate.confidence import Assessment, assess, model_signal, result_fields
+from agent.translate.confidence import Assessment, assess, model_signal, result_fields, with_doubt
 from agent.translate.engine import FORK_RECORD_FLOOR, CancelFlag, Fork, Generation
+from agent.translate.explain import explain
 from agent.translate.meaning import Doubt, skill_words
 from agent.translate.model_path import ModelNotFoundError
 from agent.translate.names import DETERMINERS, FUNCTION_WORDS, NOT_NAMES, offered_names
@@ -265,7 +266,8 @@ class Translator:
             generating = timings["prompt"] + timings["generate"]
             if len(states) == 1 and assessment.doubts:
                 other = (self._shorter_ending(states[0], normalized, known)
-                         or self._other_choice(states[0], normalized, known, cancel, timings))
+                         or self._other_choice(states[0], normalized, known, cancel, timings)
+                         or self._clause_by_clause(normalized, plan, assessment, known, cancel, timings))
                 if other is not None:
                     program, plan, _probabilities, assessment = other
             guessed = self._guessed_and_doubted(states, assessment.doubts)
@@ -346,6 +348,47 @@ class Translator:
                            passing[0].strip())
             return passing
         return None
+
+    def _clause_by_clause(self, normalized: str, whole: Plan, judged: Assessment, known: Collection[str] | None,
+                          cancel: CancelFlag | None, timings: dict[str, float]) -> _Candidate | None:
+        """The program from reading the task a clause at a time, where the whole task's program fails a
+        meaning check and that one passes them; the generations' time is added to `timings`.
+
+        Read whole, a task of two activities often comes out as one of them ("fetch the mug, then look
+        around" without the look), or a count spreads over the whole task ("go forward, then turn left
+        twice" doing both twice); a clause read alone has no other step to lose or repeat. Splitting
+        always was worth nothing on unseen tasks, and a split reading loses what ties clauses together
+        (a correction, a negation), so it is only a way out of a doubted plan: every clause must read
+        as a task, and the readings disagreed, so the plan it gives is always put to the person.
+        """
+        if self.options.split_clauses:
+            return None
+        states = [_ClauseState(c) for c in split_clauses(normalized, self.profile)]
+        if len(states) < 2:
+            return None
+        for state in states:
+            if state.clause.repeat_previous:
+                continue
+            state.objects = self._task_objects(state.clause.text)
+            generation = self.engine.generate(self.prompt_for(state.clause.text), self._automaton(state),
+                                              MAX_TOKENS, cancel)
+            timings["prompt"] += generation.prompt_ms
+            timings["generate"] += generation.generate_ms
+            state.program = _tidy(generation.text)
+            if (not generation.finished or state.program == NO_PROGRAM + "\n"
+                    or not _sure_it_is_a_task(task_reading(generation, self.profile))):
+                return None
+            state.probabilities = generation.token_probabilities
+        probabilities = tuple(p for s in states for p in s.probabilities)
+        passing = self._passing(_assemble(states), probabilities, normalized, known)
+        if passing is None:
+            return None
+        program, plan, probabilities, assessment = passing
+        progress.debug("the checks found fault with the whole program; read a clause at a time (%s) it gives "
+                       "%r, which passes them", " | ".join(repr(s.clause.text) for s in states), program.strip())
+        disagreement = Doubt("whole", f"read whole, the task gave another plan ({explain(whole, self.profile)}), "
+                                      f"and {judged.doubts[0].reason}; this one reads it a step at a time")
+        return program, plan, probabilities, with_doubt(assessment, disagreement)
 
     def _passing(self, program: str, probabilities: tuple[float, ...], normalized: str,
                  known: Collection[str] | None) -> _Candidate | None:

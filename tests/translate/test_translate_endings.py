@@ -7,9 +7,11 @@ from agent.normalize import normalize_task
 from agent.translate import Translator
 from agent.translate.automaton import RslAutomaton
 from agent.translate.clauses import Clause
-from agent.translate.confidence import UNSURE_BELOW
+from agent.translate.confidence import UNSURE_BELOW, Assessment, assess
 from agent.translate.engine import Fork
 from agent.translate.translator import ENDING_FLOOR, FORK_FLOOR, _ClauseState, _end_where_weighed
+from rsl.compiler import compile_program
+from rsl.plan import Plan
 
 SQUARE_SIDE = "forward 1;\nturnleft 1.5708;\n"
 
@@ -149,3 +151,60 @@ def test_the_cut_keeps_the_statements_before_the_likeliest_ending() -> None:
     assert state.probabilities == (*(0.9 for _ in range(33)), 0.35)
     assert state.tokens == tuple(range(33)) and state.forks == ((5, 7, 0.2),)
     assert [e[0] for e in state.endings] == [1, 2]
+
+
+LOOK_AROUND = "lookleft 1.5708;\nperceive;\nlookright 3.1416;\nperceive;\nlookleft 1.5708;\n"
+FETCH_MUG = "approach mug;\ngrasp mug;\ngoto 0, 0;\n"
+
+
+def _read_whole(translator: Translator, task: str, program: str) -> tuple[str, Plan, Assessment]:
+    """The normalized task with a whole reading's plan of `program` and the checks' assessment of it."""
+    normalized = normalize_task(task)
+    plan = compile_program(program, translator.profile).plan
+    assert plan is not None
+    return normalized, plan, assess(normalized, plan, translator.profile, model=0.9)
+
+
+def test_a_doubted_whole_reading_is_read_a_clause_at_a_time_and_questioned(adapted: Translator) -> None:
+    # Read whole, the shipped adapter drives to the mug and looks around, leaving out the fetch.
+    normalized, plan, judged = _read_whole(adapted, "Fetch the mug, then look around.", "approach mug;\n" + LOOK_AROUND)
+    assert judged.doubts
+    timings = {"prompt": 0.0, "generate": 0.0}
+    found = adapted._clause_by_clause(normalized, plan, judged, None, None, timings)
+    assert found is not None and timings["generate"] > 0
+    program, _plan, _probabilities, assessment = found
+    assert program == FETCH_MUG + LOOK_AROUND
+    # The two readings disagreed: the person is asked, and told why.
+    assert assessment.unsure and [d.check for d in assessment.doubts] == ["whole"]
+    assert "a step at a time" in assessment.reasons[0] and "drive up to the mug" in assessment.reasons[0]
+
+
+def test_a_clause_the_model_does_not_read_as_a_task_gives_no_clause_by_clause_reading(adapted: Translator) -> None:
+    # "actually skip the turn" alone is no task: dropping it would do the turn that was taken back.
+    task = "Drive forward four metres and turn left, actually skip the turn."
+    normalized, plan, judged = _read_whole(adapted, task, "forward 4;\nturnleft 1.5708;\n")
+    assert judged.doubts
+    assert adapted._clause_by_clause(normalized, plan, judged, None, None, {"prompt": 0.0, "generate": 0.0}) is None
+
+
+def test_a_task_of_one_clause_is_not_read_again(adapted: Translator) -> None:
+    normalized, plan, judged = _read_whole(adapted, "turn around to the right", "turnleft 3.1416;\n")
+    assert judged.doubts
+    timings = {"prompt": 0.0, "generate": 0.0}
+    assert adapted._clause_by_clause(normalized, plan, judged, None, None, timings) is None
+    assert timings["prompt"] + timings["generate"] == 0.0
+
+
+def test_a_translator_that_splits_already_does_not_read_a_clause_at_a_time_again(translator: Translator) -> None:
+    normalized, plan, judged = _read_whole(translator, "Fetch the mug, then look around.",
+                                           "approach mug;\n" + LOOK_AROUND)
+    timings = {"prompt": 0.0, "generate": 0.0}
+    assert translator._clause_by_clause(normalized, plan, judged, None, None, timings) is None
+    assert timings["prompt"] + timings["generate"] == 0.0
+
+
+def test_two_activities_read_whole_into_one_come_back_both_and_questioned(adapted: Translator) -> None:
+    result = adapted.translate("Fetch the mug, then look around.")
+    assert result.verified and result.program == FETCH_MUG + LOOK_AROUND
+    assert result.confirm and any("a step at a time" in d for d in result.doubts)
+    assert "whole" in result.doubted_by
