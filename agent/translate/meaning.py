@@ -104,6 +104,8 @@ class Doubt:
 
     check: str
     reason: str
+    # The plan's steps (from 0) it is about, where the check can tell which and leaving them out may mend it.
+    steps: tuple[int, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -705,15 +707,15 @@ def _cancelled(text: str, plan: Plan, vocab: _Vocabulary, profile: Profile) -> l
     if not spans:
         return []
     mentions = [(m.start(), m.group(0)) for m in _WORD.finditer(text)]
-    doubts = []
-    for command in plan:
+    steps: dict[str, list[int]] = {}
+    for index, command in enumerate(plan):
         words = vocab.step_words.get(command.skill, frozenset())
         last = next((at for at, token in reversed(mentions) if any(_inflected(token, w) for w in words)), None)
         span = next((said for start, end, said in spans if last is not None and start <= last < end), None)
         if span is not None:
-            doubts.append(Doubt("cancelled", f'you said "{span}", but the plan still does it '
-                                             f"({say(command, profile)})"))
-    return list({d.reason: d for d in doubts}.values())
+            reason = f'you said "{span}", but the plan still does it ({say(command, profile)})'
+            steps.setdefault(reason, []).append(index)
+    return [Doubt("cancelled", reason, tuple(indices)) for reason, indices in steps.items()]
 
 
 def _only(affirmed: str, plan: Plan, vocab: _Vocabulary, named: list[_Convention], profile: Profile

@@ -265,7 +265,8 @@ class Translator:
             assessment = assess(normalized, plan, self.profile, model=model, known_objects=known)
             generating = timings["prompt"] + timings["generate"]
             if len(states) == 1 and assessment.doubts:
-                other = (self._shorter_ending(states[0], normalized, known)
+                other = (self._without_taken_back(states[0], plan, assessment, normalized, known)
+                         or self._shorter_ending(states[0], normalized, known)
                          or self._other_choice(states[0], normalized, known, cancel, timings)
                          or self._clause_by_clause(normalized, plan, assessment, known, cancel, timings))
                 if other is not None:
@@ -286,6 +287,30 @@ class Translator:
         return TranslationResult(task=task, program=program, verified=verified,
                                  passes=len(attempts), attempts=tuple(attempts),
                                  plan=plan, model=self.model_name, timings_ms=timings, **judged)
+
+    def _without_taken_back(self, state: _ClauseState, plan: Plan, judged: Assessment, normalized: str,
+                            known: Collection[str] | None) -> _Candidate | None:
+        """The plan without the steps the person took back, where the checks found them still in it and
+        pass the rest.
+
+        "Drive forward 4 m and turn left, actually skip the turn" comes out with the turn: the model reads
+        the take-back as words, not as an edit. The check that doubts it knows which steps were taken
+        back, so leaving them out costs no generation. The model did write them, so the plan is always
+        put to the person.
+        """
+        dropped = {i for d in judged.doubts if d.check == "cancelled" for i in d.steps}
+        if not dropped:
+            return None
+        kept = "".join(c.to_rsl() + "\n" for i, c in enumerate(plan) if i not in dropped)
+        passing = self._passing(kept, state.probabilities, normalized, known)
+        if passing is None:
+            return None
+        program, plan_kept, probabilities, assessment = passing
+        said = explain(Plan(tuple(c for i, c in enumerate(plan) if i in dropped), plan.profile), self.profile)
+        progress.debug("the plan still did what the task took back (%s); without it, it passes the checks", said)
+        taken_back = Doubt("taken back", f"the model's plan also did what you took back ({said}); "
+                                         "this one leaves it out")
+        return program, plan_kept, probabilities, with_doubt(assessment, taken_back)
 
     def _shorter_ending(self, state: _ClauseState, normalized: str, known: Collection[str] | None
                         ) -> _Candidate | None:

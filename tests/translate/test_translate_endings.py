@@ -208,3 +208,39 @@ def test_two_activities_read_whole_into_one_come_back_both_and_questioned(adapte
     assert result.verified and result.program == FETCH_MUG + LOOK_AROUND
     assert result.confirm and any("a step at a time" in d for d in result.doubts)
     assert "whole" in result.doubted_by
+
+
+def _whole_state(task: str, program: str) -> _ClauseState:
+    state = _ClauseState(Clause(text=normalize_task(task)))
+    state.program = program
+    state.probabilities = (0.9, 0.95)
+    return state
+
+
+def test_a_step_taken_back_is_left_out_and_the_plan_questioned(translator: Translator) -> None:
+    task = "Drive forward four metres and turn left, actually skip the turn."
+    normalized, plan, judged = _read_whole(translator, task, "forward 4;\nturnleft 1.5708;\n")
+    found = translator._without_taken_back(_whole_state(task, "forward 4;\nturnleft 1.5708;\n"), plan, judged,
+                                           normalized, None)
+    assert found is not None
+    program, kept, probabilities, assessment = found
+    assert program == "forward 4;\n" and len(kept) == 1 and probabilities == (0.9, 0.95)
+    assert assessment.unsure and [d.check for d in assessment.doubts] == ["taken back"]
+    assert "turn left 90°" in assessment.reasons[0]
+
+
+def test_nothing_is_left_out_of_a_plan_no_take_back_doubts(translator: Translator) -> None:
+    task = "turn around to the right"
+    normalized, plan, judged = _read_whole(translator, task, "turnleft 3.1416;\n")
+    assert judged.doubts
+    assert translator._without_taken_back(_whole_state(task, "turnleft 3.1416;\n"), plan, judged,
+                                          normalized, None) is None
+
+
+def test_what_is_left_after_the_take_back_must_pass_the_checks_too(translator: Translator) -> None:
+    # Without the drive, the 1 m said for it is unused: still doubted, so not taken.
+    task = "Move forward one metre, then look down. Actually, skip moving, just look down."
+    normalized, plan, judged = _read_whole(translator, task, "forward 1;\nlookdown 0.5236;\n")
+    assert any(d.check == "cancelled" for d in judged.doubts)
+    assert translator._without_taken_back(_whole_state(task, "forward 1;\nlookdown 0.5236;\n"), plan, judged,
+                                          normalized, None) is None

@@ -343,3 +343,12 @@ def test_a_robot_described_otherwise_gets_its_own_parts(profile: Profile) -> Non
     assert other.digest == profile.digest
     assert skill_parts(profile)["lookup"] == "head"
     assert skill_parts(other)["lookup"] == "base"
+
+
+def test_a_step_taken_back_is_named_by_its_place_in_the_plan(profile: Profile) -> None:
+    task = normalize_task("turn left, drive forward 2 m and turn left again, actually skip the turn")
+    doubts = check_meaning(task, plan("turnleft 1.5708; forward 2; turnleft 1.5708;", profile), profile)
+    cancelled = [d for d in doubts if d.check == "cancelled"]
+    # One reason for the same step done twice, naming both places.
+    assert len(cancelled) == 1 and cancelled[0].steps == (0, 2)
+    assert all(not d.steps for d in doubts if d.check != "cancelled")
