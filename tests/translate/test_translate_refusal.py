@@ -6,6 +6,7 @@ import dataclasses
 
 import pytest
 
+from agent.normalize import normalize_task
 from agent.translate import Translator
 from agent.translate.automaton import END, START, RslAutomaton
 from agent.translate.engine import CancelFlag, Fork, Generation, TokenMasks
@@ -128,3 +129,33 @@ def test_a_doubted_plan_the_model_guessed_at_is_refused_as_no_task(adapted: Tran
         assert diagnostic.code is Code.NOT_A_TASK
         assert f"the model was {probability:.0%} sure it was one" in diagnostic.message
         assert sure.doubts[0] in diagnostic.message
+
+
+@pytest.mark.parametrize(("task", "phrase"), [
+    ("Sweep the floor near the oven.", "sweep the floor"),
+    ("put the cup on the table", "put the"),
+    ("please switch on the kettle", "switch on"),
+    ("could you turn off the lights", "turn off"),
+    ("sing me a song", "sing"),
+])
+def test_what_the_default_robot_cannot_do_is_named_in_its_profile(task: str, phrase: str, profile: Profile) -> None:
+    found = profile.inability(normalize_task(task))
+    assert found is not None and found[1] == phrase
+
+
+@pytest.mark.parametrize("task", [
+    "go close to the table", "grab the clean cup", "drive to the elevator", "bring me my phone", "turn on the spot",
+    "go to the charger", "fetch the mop", "look at the open door", "bring me the vacuum",
+    "sweep the room with your camera",
+])
+def test_a_task_near_those_words_is_not_taken_for_one(task: str, profile: Profile) -> None:
+    assert profile.inability(normalize_task(task)) is None
+
+
+def test_a_request_the_default_robot_cannot_carry_out_is_refused_with_the_reason(adapted: Translator) -> None:
+    # The shipped adapter had driven up to the oven.
+    result = adapted.translate("Sweep the floor near the oven.")
+    assert not result.verified and result.plan is None and result.passes == 0 and result.refused
+    [diagnostic] = result.attempts[-1].diagnostics
+    assert diagnostic.code is Code.NOT_A_TASK
+    assert "asks the default robot to sweep the floor, and it cannot clean" in diagnostic.message
