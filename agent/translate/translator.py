@@ -383,8 +383,9 @@ class Translator:
         around" without the look), or a count spreads over the whole task ("go forward, then turn left
         twice" doing both twice); a clause read alone has no other step to lose or repeat. Splitting
         always was worth nothing on unseen tasks, and a split reading loses what ties clauses together
-        (a correction, a negation), so it is only a way out of a doubted plan: every clause must read
-        as a task, and the readings disagreed, so the plan it gives is always put to the person.
+        (a correction, a negation), so it is only a way out of a doubted plan, and the checks read the
+        whole task. A clause that reads as no task ("keep your head still") gives no step. The readings
+        disagreed, so the plan it gives is always put to the person.
         """
         if self.options.split_clauses:
             return None
@@ -399,11 +400,13 @@ class Translator:
                                               MAX_TOKENS, cancel)
             timings["prompt"] += generation.prompt_ms
             timings["generate"] += generation.generate_ms
-            state.program = _tidy(generation.text)
-            if (not generation.finished or state.program == NO_PROGRAM + "\n"
-                    or not _sure_it_is_a_task(task_reading(generation, self.profile))):
+            if not generation.finished:
                 return None
+            state.program = _tidy(generation.text)
             state.probabilities = generation.token_probabilities
+            if state.program == NO_PROGRAM + "\n" or not _sure_it_is_a_task(task_reading(generation, self.profile)):
+                # "keep your head still" asks for no step of its own; the checks still read it in the task.
+                state.program, state.probabilities = "", ()
         probabilities = tuple(p for s in states for p in s.probabilities)
         passing = self._passing(_assemble(states), probabilities, normalized, known)
         if passing is None:

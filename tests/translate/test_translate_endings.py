@@ -179,8 +179,8 @@ def test_a_doubted_whole_reading_is_read_a_clause_at_a_time_and_questioned(adapt
     assert "a step at a time" in assessment.reasons[0] and "drive up to the mug" in assessment.reasons[0]
 
 
-def test_a_clause_the_model_does_not_read_as_a_task_gives_no_clause_by_clause_reading(adapted: Translator) -> None:
-    # "actually skip the turn" alone is no task: dropping it would do the turn that was taken back.
+def test_a_take_back_read_alone_still_counts_against_the_clause_by_clause_reading(adapted: Translator) -> None:
+    # "actually skip the turn" alone is no task and gives no step, but the checks read the whole task.
     task = "Drive forward four metres and turn left, actually skip the turn."
     normalized, plan, judged = _read_whole(adapted, task, "forward 4;\nturnleft 1.5708;\n")
     assert judged.doubts
@@ -244,3 +244,14 @@ def test_what_is_left_after_the_take_back_must_pass_the_checks_too(translator: T
     assert any(d.check == "cancelled" for d in judged.doubts)
     assert translator._without_taken_back(_whole_state(task, "forward 1;\nlookdown 0.5236;\n"), plan, judged,
                                           normalized, None) is None
+
+
+def test_a_clause_that_reads_as_no_task_gives_no_step_of_the_clause_by_clause_reading(adapted: Translator) -> None:
+    # Read whole, the shipped adapter pans the head that was to be kept still.
+    task = "Keep your head still and turn right 45 degrees."
+    normalized, plan, judged = _read_whole(adapted, task, "lookright 0.7854;\n")
+    assert [d.check for d in judged.doubts] == ["negation"]
+    found = adapted._clause_by_clause(normalized, plan, judged, None, None, {"prompt": 0.0, "generate": 0.0})
+    assert found is not None
+    program, _plan, _probabilities, assessment = found
+    assert program == "turnright 0.7854;\n" and assessment.unsure
