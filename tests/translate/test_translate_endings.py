@@ -180,11 +180,14 @@ def test_a_doubted_whole_reading_is_read_a_clause_at_a_time_and_questioned(adapt
 
 
 def test_a_take_back_read_alone_still_counts_against_the_clause_by_clause_reading(adapted: Translator) -> None:
-    # "actually skip the turn" alone is no task and gives no step, but the checks read the whole task.
-    task = "Drive forward four metres and turn left, actually skip the turn."
-    normalized, plan, judged = _read_whole(adapted, task, "forward 4;\nturnleft 1.5708;\n")
-    assert judged.doubts
-    assert adapted._clause_by_clause(normalized, plan, judged, None, None, {"prompt": 0.0, "generate": 0.0}) is None
+    # "skip the turn" is a clause of its own: whatever it gives, the checks read it in the whole task, and
+    # the turn the first clause gives is still taken back.
+    task = "turn left, then drive forward 2 metres, then skip the turn"
+    normalized, plan, judged = _read_whole(adapted, task, "turnleft 1.5708;\nforward 2;\n")
+    assert [d.check for d in judged.doubts] == ["cancelled"]
+    timings = {"prompt": 0.0, "generate": 0.0}
+    assert adapted._clause_by_clause(normalized, plan, judged, None, None, timings) is None
+    assert timings["generate"] > 0
 
 
 def test_a_task_of_one_clause_is_not_read_again(adapted: Translator) -> None:
