@@ -220,9 +220,7 @@ class Translator:
         for _ in range(self.options.max_passes):
             for state in pending:
                 prompt = self.prompt_for(state.clause.text, state.extra)
-                generation = self.engine.generate(prompt, self._automaton(state), MAX_TOKENS, cancel)
-                timings["prompt"] += generation.prompt_ms
-                timings["generate"] += generation.generate_ms
+                generation = self._generate(prompt, self._automaton(state), cancel, timings)
                 state.program = _tidy(generation.text)
                 state.probabilities = generation.token_probabilities
                 state.endings = generation.endings
@@ -360,9 +358,7 @@ class Translator:
             if probability < FORK_FLOOR:
                 break
             fork = Fork(state.tokens[:position], state.probabilities[:position], token)
-            generation = self.engine.generate(prompt, automaton, MAX_TOKENS, cancel, fork=fork)
-            timings["prompt"] += generation.prompt_ms
-            timings["generate"] += generation.generate_ms
+            generation = self._generate(prompt, automaton, cancel, timings, fork)
             if not generation.finished:
                 continue
             passing = self._passing(_tidy(generation.text), generation.token_probabilities, normalized, known)
@@ -396,10 +392,7 @@ class Translator:
             if state.clause.repeat_previous:
                 continue
             state.objects = self._task_objects(state.clause.text)
-            generation = self.engine.generate(self.prompt_for(state.clause.text), self._automaton(state),
-                                              MAX_TOKENS, cancel)
-            timings["prompt"] += generation.prompt_ms
-            timings["generate"] += generation.generate_ms
+            generation = self._generate(self.prompt_for(state.clause.text), self._automaton(state), cancel, timings)
             if not generation.finished:
                 return None
             state.program = _tidy(generation.text)
@@ -417,6 +410,14 @@ class Translator:
         disagreement = Doubt("whole", f"read whole, the task gave another plan ({explain(whole, self.profile)}), "
                                       f"and {judged.doubts[0].reason}; this one reads it a step at a time")
         return program, plan, probabilities, with_doubt(assessment, disagreement)
+
+    def _generate(self, prompt: str, automaton: RslAutomaton | None, cancel: CancelFlag | None,
+                  timings: dict[str, float], fork: Fork | None = None) -> Generation:
+        """One generation, its time added to `timings` so a task's total counts every way out tried."""
+        generation = self.engine.generate(prompt, automaton, MAX_TOKENS, cancel, fork=fork)
+        timings["prompt"] += generation.prompt_ms
+        timings["generate"] += generation.generate_ms
+        return generation
 
     def _passing(self, program: str, probabilities: tuple[float, ...], normalized: str,
                  known: Collection[str] | None) -> _Candidate | None:
