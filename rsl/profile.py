@@ -184,6 +184,16 @@ class Inability:
 
 
 @dataclass(frozen=True)
+class PartBack:
+    """Words that put a part of the robot back as it was ("look straight ahead again" for the head): the
+    steps that undo the part's movement come from its skills' opposites, not from the model."""
+
+    part: str  # a noun of the robot's description, e.g. "head"
+    what: str  # how explain-back and the docs say it, e.g. "the head back to straight ahead and level"
+    phrases: tuple[str, ...]  # lowercase words that end a task by asking for it
+
+
+@dataclass(frozen=True)
 class Motion:
     """The profile's `[motion]` table."""
 
@@ -218,6 +228,7 @@ class Profile:
     conventions: tuple[Convention, ...]
     digest: str = field(repr=False)
     cannot: tuple[Inability, ...] = ()
+    back: tuple[PartBack, ...] = ()
     source: str = field(repr=False, default="")
 
     def skill(self, keyword: str) -> Skill | None:
@@ -326,6 +337,17 @@ def _build(data: dict[str, Any], source: str) -> Profile:
                 if phrase.lower() in (skill.keyword, *skill.aliases):
                     raise fail(f"[[cannot]] phrase {phrase!r} is a word for the skill `{skill.keyword}`")
         cannot.append(Inability(what=what, phrases=tuple(p.strip().lower() for p in phrases)))
+    back = []
+    for index, raw in enumerate(data.get("back", []), start=1):
+        part, what, phrases = raw.get("part"), raw.get("what"), raw.get("phrases")
+        if (not isinstance(part, str) or not part or not isinstance(what, str) or not what
+                or not isinstance(phrases, list) or not phrases
+                or not all(isinstance(p, str) and p.strip() for p in phrases)):
+            raise fail(f"[[back]] #{index} needs `part` (a part of the robot), `what` (a sentence) and "
+                       "`phrases` (a list of words)")
+        if not re.search(rf"\b{re.escape(part.lower())}\b", str(robot.get("description", "")).lower()):
+            raise fail(f"[[back]] #{index}: part {part!r} is not named in the robot's description")
+        back.append(PartBack(part=part.lower(), what=what, phrases=tuple(p.strip().lower() for p in phrases)))
     max_statements = read_settings(_Limits, data.get("limits", {}), error=ProfileError, source=source,
                                    prefix="limits.", docs="docs/skills.md").max_statements
 
@@ -342,6 +364,7 @@ def _build(data: dict[str, Any], source: str) -> Profile:
         digest=_language_digest(data),
         source=source,
         cannot=tuple(cannot),
+        back=tuple(back),
     )
 
 

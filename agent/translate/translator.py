@@ -29,6 +29,7 @@ from agent.translate.explain import explain
 from agent.translate.meaning import Doubt, skill_words
 from agent.translate.model_path import ModelNotFoundError
 from agent.translate.names import DETERMINERS, FUNCTION_WORDS, NOT_NAMES, offered_names
+from agent.translate.part_back import PutBack, put_back, undoing
 from agent.translate.prompt import (
     Shot,
     chat_prompt,
@@ -205,6 +206,11 @@ class Translator:
             return TranslationResult(task=task, program="", verified=False, passes=0,
                                      attempts=(Attempt(program="", diagnostics=(beyond,)),), plan=None,
                                      model=self.model_name, timings_ms={**timings, "total": 0.0})
+        back = put_back(normalized, self.profile)
+        if back is not None:
+            # The model and the checks read what comes before; the steps that put the part back are exact.
+            progress.debug("task ends by putting the %s back (%r); reading %r", back.part, back.phrase, back.before)
+            normalized = back.before
         clauses = (split_clauses(normalized, self.profile) if self.options.split_clauses
                    else [Clause(text=normalized)])
         states = [_ClauseState(c) for c in clauses]
@@ -269,6 +275,8 @@ class Translator:
                          or self._clause_by_clause(normalized, plan, assessment, known, cancel, timings))
                 if other is not None:
                     program, plan, _probabilities, assessment = other
+            if back is not None:
+                program, plan = self._putting_back(program, plan, back, known)
             guessed = self._guessed_and_doubted(states, assessment.doubts)
             if guessed is not None:
                 attempts[-1] = Attempt(program=program, diagnostics=(guessed,))
@@ -285,6 +293,19 @@ class Translator:
         return TranslationResult(task=task, program=program, verified=verified,
                                  passes=len(attempts), attempts=tuple(attempts),
                                  plan=plan, model=self.model_name, timings_ms=timings, **judged)
+
+    def _putting_back(self, program: str, plan: Plan, back: PutBack, known: Collection[str] | None
+                      ) -> tuple[str, Plan]:
+        """The program and plan with the steps that put `back.part` back as it was appended; unchanged when
+        the part did not move, or when the steps would make the program fail to compile (too long)."""
+        steps = undoing(plan, back.part, self.profile)
+        if not steps:
+            return program, plan
+        whole = compile_program(program + steps, self.profile, known)
+        if not whole.ok or whole.plan is None:
+            return program, plan
+        progress.debug("putting the %s back: %r", back.part, steps.strip())
+        return program + steps, whole.plan
 
     def _without_taken_back(self, state: _ClauseState, plan: Plan, judged: Assessment, normalized: str,
                             known: Collection[str] | None) -> _Candidate | None:

@@ -100,3 +100,19 @@ def test_profile_settings_are_checked_like_every_other_setting(patch, replacemen
     with pytest.raises(ProfileError) as caught:
         parse_profile(text.replace(patch, replacement, 1), source="my.toml")
     assert str(caught.value) == message
+
+
+@pytest.mark.parametrize(("table", "complaint"), [
+    ('part = "tail"\nwhat = "the tail back"\nphrases = ["tail back"]', "part 'tail' is not named"),
+    ('part = "head"\nwhat = "the head back"\nphrases = []', "needs `part`"),
+    ('part = "head"\nphrases = ["head back"]', "needs `part`"),
+])
+def test_a_part_put_back_must_be_a_part_of_the_robot_with_its_words(table, complaint):
+    text = default_profile_path().read_text() + "\n[[back]]\n" + table + "\n"
+    with pytest.raises(ProfileError, match=complaint):
+        parse_profile(text, source="broken.toml")
+
+
+def test_the_default_robot_puts_its_head_back(profile):
+    assert [b.part for b in profile.back] == ["head"]
+    assert "look straight ahead again" in profile.back[0].phrases
