@@ -189,7 +189,6 @@ class PartBack:
     steps that undo the part's movement come from its skills' opposites, not from the model."""
 
     part: str  # a noun of the robot's description, e.g. "head"
-    what: str  # how explain-back and the docs say it, e.g. "the head back to straight ahead and level"
     phrases: tuple[str, ...]  # lowercase words that end a task by asking for it
 
 
@@ -339,15 +338,13 @@ def _build(data: dict[str, Any], source: str) -> Profile:
         cannot.append(Inability(what=what, phrases=tuple(p.strip().lower() for p in phrases)))
     back = []
     for index, raw in enumerate(data.get("back", []), start=1):
-        part, what, phrases = raw.get("part"), raw.get("what"), raw.get("phrases")
-        if (not isinstance(part, str) or not part or not isinstance(what, str) or not what
-                or not isinstance(phrases, list) or not phrases
+        part, phrases = raw.get("part"), raw.get("phrases")
+        if (not isinstance(part, str) or not part or not isinstance(phrases, list) or not phrases
                 or not all(isinstance(p, str) and p.strip() for p in phrases)):
-            raise fail(f"[[back]] #{index} needs `part` (a part of the robot), `what` (a sentence) and "
-                       "`phrases` (a list of words)")
+            raise fail(f"[[back]] #{index} needs `part` (a part of the robot) and `phrases` (a list of words)")
         if not re.search(rf"\b{re.escape(part.lower())}\b", str(robot.get("description", "")).lower()):
             raise fail(f"[[back]] #{index}: part {part!r} is not named in the robot's description")
-        back.append(PartBack(part=part.lower(), what=what, phrases=tuple(p.strip().lower() for p in phrases)))
+        back.append(PartBack(part=part.lower(), phrases=tuple(p.strip().lower() for p in phrases)))
     max_statements = read_settings(_Limits, data.get("limits", {}), error=ProfileError, source=source,
                                    prefix="limits.", docs="docs/skills.md").max_statements
 

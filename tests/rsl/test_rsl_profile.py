@@ -103,9 +103,9 @@ def test_profile_settings_are_checked_like_every_other_setting(patch, replacemen
 
 
 @pytest.mark.parametrize(("table", "complaint"), [
-    ('part = "tail"\nwhat = "the tail back"\nphrases = ["tail back"]', "part 'tail' is not named"),
-    ('part = "head"\nwhat = "the head back"\nphrases = []', "needs `part`"),
-    ('part = "head"\nphrases = ["head back"]', "needs `part`"),
+    ('part = "tail"\nphrases = ["tail back"]', "part 'tail' is not named"),
+    ('part = "head"\nphrases = []', "needs `part`"),
+    ('phrases = ["head back"]', "needs `part`"),
 ])
 def test_a_part_put_back_must_be_a_part_of_the_robot_with_its_words(table, complaint):
     text = default_profile_path().read_text() + "\n[[back]]\n" + table + "\n"
