@@ -14,6 +14,7 @@ import json
 import keyword as python_keyword
 import re
 import tomllib
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -326,25 +327,17 @@ def _build(data: dict[str, Any], source: str) -> Profile:
         for c in data.get("conventions", [])
     )
     cannot = []
-    for index, raw in enumerate(data.get("cannot", []), start=1):
-        what, phrases = raw.get("what"), raw.get("phrases")
-        if (not isinstance(what, str) or not what or not isinstance(phrases, list) or not phrases
-                or not all(isinstance(p, str) and p.strip() for p in phrases)):
-            raise fail(f"[[cannot]] #{index} needs `what` (a sentence) and `phrases` (a list of words)")
+    for _index, what, phrases in _phrase_tables(data, "cannot", "what", "a sentence", fail):
         for phrase in phrases:
             for skill in skills:
-                if phrase.lower() in (skill.keyword, *skill.aliases):
+                if phrase in (skill.keyword, *skill.aliases):
                     raise fail(f"[[cannot]] phrase {phrase!r} is a word for the skill `{skill.keyword}`")
-        cannot.append(Inability(what=what, phrases=tuple(p.strip().lower() for p in phrases)))
+        cannot.append(Inability(what=what, phrases=phrases))
     back = []
-    for index, raw in enumerate(data.get("back", []), start=1):
-        part, phrases = raw.get("part"), raw.get("phrases")
-        if (not isinstance(part, str) or not part or not isinstance(phrases, list) or not phrases
-                or not all(isinstance(p, str) and p.strip() for p in phrases)):
-            raise fail(f"[[back]] #{index} needs `part` (a part of the robot) and `phrases` (a list of words)")
+    for index, part, phrases in _phrase_tables(data, "back", "part", "a part of the robot", fail):
         if not re.search(rf"\b{re.escape(part.lower())}\b", str(robot.get("description", "")).lower()):
             raise fail(f"[[back]] #{index}: part {part!r} is not named in the robot's description")
-        back.append(PartBack(part=part.lower(), phrases=tuple(p.strip().lower() for p in phrases)))
+        back.append(PartBack(part=part.lower(), phrases=phrases))
     max_statements = read_settings(_Limits, data.get("limits", {}), error=ProfileError, source=source,
                                    prefix="limits.", docs="docs/skills.md").max_statements
 
@@ -364,6 +357,17 @@ def _build(data: dict[str, Any], source: str) -> Profile:
         back=tuple(back),
     )
 
+
+
+def _phrase_tables(data: dict[str, Any], table: str, key: str, shape: str,
+                   fail: Callable[[str], ProfileError]) -> Iterator[tuple[int, str, tuple[str, ...]]]:
+    """Each `[[table]]` entry as (its number, its `key`, its phrases lower-cased); raises on a malformed one."""
+    for index, raw in enumerate(data.get(table, []), start=1):
+        value, phrases = raw.get(key), raw.get("phrases")
+        if (not isinstance(value, str) or not value or not isinstance(phrases, list) or not phrases
+                or not all(isinstance(p, str) and p.strip() for p in phrases)):
+            raise fail(f"[[{table}]] #{index} needs `{key}` ({shape}) and `phrases` (a list of words)")
+        yield index, value, tuple(p.strip().lower() for p in phrases)
 
 # What a skill's statement is and means; bindings, spoken wording and the
 # like say how the robot does it or tells it, not what the adapter learned.

@@ -113,6 +113,17 @@ def test_a_part_put_back_must_be_a_part_of_the_robot_with_its_words(table, compl
         parse_profile(text, source="broken.toml")
 
 
+
+@pytest.mark.parametrize(("table", "complaint"), [
+    ('what = "water plants"\nphrases = []', r"\[\[cannot\]\] #\d+ needs `what` \(a sentence\)"),
+    ('phrases = ["water the plants"]', r"needs `what`"),
+    ('what = "water plants"\nphrases = ["Forward "]', "phrase 'forward' is a word for the skill `forward`"),
+])
+def test_what_a_robot_cannot_do_needs_its_sentence_and_words_that_are_no_skill(table, complaint):
+    text = default_profile_path().read_text() + "\n[[cannot]]\n" + table + "\n"
+    with pytest.raises(ProfileError, match=complaint):
+        parse_profile(text, source="broken.toml")
+
 def test_the_default_robot_puts_its_head_back(profile):
     assert [b.part for b in profile.back] == ["head"]
     assert "look straight ahead again" in profile.back[0].phrases
