@@ -36,14 +36,15 @@ def put_back(task: str, profile: Profile) -> PutBack | None:
     """The part a normalized task's last clause puts back, with the text before it; None when it puts
     none back or says nothing before it (then there is nothing to undo, and the task is read whole)."""
     for back in profile.back:
-        for phrase in back.phrases:
-            found = re.search(rf"\b{re.escape(phrase)}\b", task)
-            if found is None or not _TRAILING.fullmatch(task, found.end()):
+        # Longest first, so "look straight ahead again" is read whole where "look straight ahead" would do.
+        phrases = "|".join(re.escape(p) for p in sorted(back.phrases, key=len, reverse=True))
+        for found in re.finditer(rf"\b(?:{phrases})\b", task):
+            if not _TRAILING.fullmatch(task, found.end()):
                 continue
             breaks = list(_CLAUSE_BREAK.finditer(task, 0, found.start()))
             before = task[:breaks[-1].start()].strip(" ,") if breaks else ""
             if before:
-                return PutBack(before=before, part=back.part, phrase=phrase)
+                return PutBack(before=before, part=back.part, phrase=found.group(0))
     return None
 
 

@@ -15,6 +15,9 @@ from rsl.profile import Profile
     ("Look left 30 degrees, then look straight ahead again.", "look left 0.5236 rad"),
     ("Look down 20 degrees and then bring your head back level.", "look down 0.3491 rad"),
     ("look up and left, then center your head please", "look up and left"),
+    # The phrase said first opens the task; the one said last ends it.
+    ("Look straight ahead, then look left 30 degrees, then look straight ahead.",
+     "look straight ahead, then look left 0.5236 rad"),
 ])
 def test_the_clause_that_puts_the_head_back_is_cut_from_what_the_model_reads(
         profile: Profile, task: str, before: str) -> None:
