@@ -25,6 +25,9 @@ from rsl.settings import read_settings, setting
 IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 SKILL_KEYWORD = re.compile(r"[a-z][a-z0-9_]*\Z")
 _AMOUNT = re.compile(r"\d\s*[a-z]+\b")
+_LOWER_WORD = re.compile(r"[a-z]+")
+# The part of the robot that moves itself as a whole: the one a skill is on when its description names no part.
+WHOLE = "base"
 
 ParamKind = Literal["number", "object"]
 
@@ -335,8 +338,10 @@ def _build(data: dict[str, Any], source: str) -> Profile:
         cannot.append(Inability(what=what, phrases=phrases))
     back = []
     for index, part, phrases in _phrase_tables(data, "back", "part", "a part of the robot", fail):
-        if not re.search(rf"\b{re.escape(part.lower())}\b", str(robot.get("description", "")).lower()):
-            raise fail(f"[[back]] #{index}: part {part!r} is not named in the robot's description")
+        parts = sorted(set(part_nouns(str(robot.get("description", ""))).values()))
+        if part.lower() not in parts:
+            raise fail(f"[[back]] #{index}: part {part!r} is not a part the robot's description names "
+                       f"(its parts: {', '.join(parts)})")
         back.append(PartBack(part=part.lower(), phrases=phrases))
     max_statements = read_settings(_Limits, data.get("limits", {}), error=ProfileError, source=source,
                                    prefix="limits.", docs="docs/skills.md").max_statements
@@ -357,6 +362,28 @@ def _build(data: dict[str, Any], source: str) -> Profile:
         back=tuple(back),
     )
 
+
+
+def part_nouns(description: str) -> dict[str, str]:
+    """The robot's parts as its description names them: noun -> the part it belongs to.
+
+    "A robot: a wheeled base, a pan-tilt head with a camera, and a gripper"
+    gives base, head and gripper, and the camera as the head's. The base,
+    which moves the robot as a whole, is always a part.
+    """
+    nouns: dict[str, str] = {}
+    for piece in re.split(r",|\band\b", description.split(":", 1)[-1]):
+        owner, _, sub = piece.partition(" with ")
+        owner_words = _LOWER_WORD.findall(owner)
+        if not owner_words:
+            continue
+        part = owner_words[-1]
+        nouns[part] = part
+        sub_words = _LOWER_WORD.findall(sub)
+        if sub_words:
+            nouns[sub_words[-1]] = part
+    nouns.setdefault(WHOLE, WHOLE)
+    return nouns
 
 
 def _phrase_tables(data: dict[str, Any], table: str, key: str, shape: str,

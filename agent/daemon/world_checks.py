@@ -20,7 +20,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
 
-from agent.translate.meaning import WHOLE, skill_parts
+from agent.translate.vocabulary import WHOLE, skill_parts
 from rsl.compiler import compile_program
 from rsl.plan import Command, ObjectRef, Plan, Quantity
 from rsl.profile import Profile

@@ -6,10 +6,9 @@ base, 90 degrees said and 688 degrees planned. Each check here compares
 the normalized task with the plan and, when they disagree, gives a reason a
 person can read ("you said 90° but the plan turns 688°").
 
-Everything is derived from the robot profile: which skills move the base or
-the head (the part their description names, see `skill_parts`), the words
-for each part (keywords, aliases, the verbs of the descriptions), the
-direction words (what tells a skill from its `opposite`) and the numbers
+Everything is derived from the robot profile, through the words
+agent/translate/vocabulary.py reads from it: which skills move the base or
+the head, the words for each part, the direction words and the numbers
 that stand in for vague amounts ([[conventions]]). No skill keyword is
 named below.
 """
@@ -26,13 +25,11 @@ from dataclasses import dataclass
 from agent.corrections import MARKERS
 from agent.translate.clauses import _SHAPES
 from agent.translate.explain import quantity, say
-from agent.translate.names import DETERMINERS, FUNCTION_WORDS
-from rsl.compiler import compile_program
+from agent.translate.names import DETERMINERS
+from agent.translate.vocabulary import NUMBER_UNIT, WHOLE, WORD, ConventionReading, Vocabulary, vocabulary
 from rsl.plan import ObjectRef, Plan, Quantity
 from rsl.profile import Profile
 
-_WORD = re.compile(r"[a-z]+")
-_NUMBER_UNIT = re.compile(r"(?<![\w.])(-?\d*\.?\d+)(?: (m|rad)\b)?")
 _COUNT = re.compile(r"\b(\d+) times\b")
 # A step said after a count: "3 times then turn right", "twice and look up".
 _STEP_AFTER = re.compile(r",?\s*(?:and\s+then|and|then)\s+[a-z]")
@@ -48,12 +45,11 @@ _CORRECTED = rf"(?:,?\s+(?:{'|'.join(MARKERS)}))+,?\s+(?:the |a |an )?"
 _TAKEN_BACK_NUMBER = re.compile(rf"(?<![\w.])(-?\d*\.?\d+)(?: (m|rad)\b)?{_CORRECTED}"
                                 r"(?=(?:(?!(?:and|then|after|next|also)\b)[a-z']+,? ){0,4}?-?\d*\.?\d+"
                                 r"(?(2) \2\b|(?! (?:m|rad)\b)))")
-_TAKEN_BACK_WORD = re.compile(rf"\b([a-z]+){_CORRECTED}([a-z]+)")
+_TAKEN_BACKWORD = re.compile(rf"\b([a-z]+){_CORRECTED}([a-z]+)")
 # An amount taken back by a marker and said again, with its step or without ("back up 1 m, scratch that,
 # back up 0.5 m").
 _CORRECTED_AMOUNT = re.compile(rf"(?<![\w.])(\d*\.?\d+) (m|rad){_CORRECTED}((?:[a-z']+,? ){{0,4}}?)(\d*\.?\d+) \2\b")
-_FIRST_CLAUSE = re.compile(r"[.;]")
-_NEXT_WORD = re.compile(r"\s+([a-z]+)")
+_NEXTWORD = re.compile(r"\s+([a-z]+)")
 # "would you mind turning left", "before grabbing the cup": the "-ing" word after "mind", "before" or
 # "after" asks for the act. Elsewhere an "-ing" form may tell what was done ("nice job turning left").
 _ASKED_DOING = re.compile(r"\b(mind|before|after) ([a-z]{3,}?)ing\b")
@@ -93,8 +89,6 @@ _QUESTION = re.compile(r"^(?:[a-z]+, )?(?:(?:why|what|where|when|who|which|how) 
                        r"(?:do|does|did|is|are|was|were|have|has|had|can|could|will|would|should)"
                        r"|(?:did|was|were|have|has|had) (?:you|it|we|they|i))\b(?!')"
                        r"(?!.*\bthen\b)[^,;.]*$")
-# The part of the robot that moves itself as a whole: the one a skill is on when its description names no part.
-WHOLE = "base"
 _TOLERANCE = 0.02
 
 
@@ -108,56 +102,19 @@ class Doubt:
     steps: tuple[int, ...] = ()
 
 
-@dataclass(frozen=True)
-class _Vocabulary:
-    parts: dict[str, str]  # skill keyword -> part ("base", "head", "gripper")
-    part_words: dict[str, frozenset[str]]  # part -> words that name it or its skills, unshared
-    directions: tuple[tuple[str, frozenset[str], str, frozenset[str]], ...]  # (skill, way, opposite, way)
-    convention_numbers: dict[str, frozenset[float]]  # unit -> values the conventions use
-    conventions: tuple[_Convention, ...]
-    coordinates: frozenset[str]  # skills whose numbers are positions, not amounts
-    skill_words: frozenset[str]  # keywords, aliases and direction words: never an object's name
-    noun_parts: dict[str, str]  # a noun of the robot's description ("camera") -> its part ("head")
-    opposites: dict[str, str]  # skill keyword -> its opposite, both ways
-    step_words: dict[str, frozenset[str]]  # skill keyword -> the words that ask for that step
-    way_skills: dict[str, frozenset[str]]  # way ("left") -> the skills that go it (turnleft, lookleft)
-    part_verbs: frozenset[str]  # the words of parts other than the base that are no noun ("look", "tilt")
-    known_words: frozenset[str]  # what a verb the profile does not list is not: its words and closed-class words
-    way_and_amount: re.Pattern[str]  # a way, then a number or a convention's amount ("back a little")
-    # The first word of a whole command that is no skill's word ("face" of "face behind") -> the parts
-    # its program moves.
-    command_verbs: dict[str, frozenset[str]]
-
-
-@dataclass(frozen=True)
-class _Convention:
-    """A profile convention as the checks read it."""
-
-    phrase: str
-    words: tuple[str, ...]
-    meaning: str
-    amounts: dict[str, frozenset[float]]  # unit -> the values it stands for
-    # An amount that stands in when nothing is said ("no amount given"): its phrase is not in its own task.
-    default: bool
-    skills: frozenset[str]  # the skills of its example program
-    whole: bool  # a whole command ("look around"), run as its program, not an amount of another step
-    # Consecutive steps of its program that act on one object (approach X; grasp X).
-    same_object: frozenset[tuple[str, str]]
-
-
 def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collection[str] | None = None
                   ) -> tuple[Doubt, ...]:
     """Every disagreement between the normalized `task` and `plan`; empty when they agree."""
-    vocab = _vocabulary(profile)
+    vocab = vocabulary(profile)
     text = _ASKED_DOING.sub(lambda m: f"{m.group(1)} to {_stem(m.group(2), vocab)}", task.lower())
     # A bare "no" before a correction ("left, no, make that right") takes a word back, not the clause.
     negated = " ".join(m.group(0) for m in _NEGATION.finditer(text) if m.group(0).strip() not in MARKERS)
     affirmed = _NEGATION.sub(lambda m: m.group(0) if m.group(0).strip() in MARKERS else " ", text)
     words = _words(affirmed, vocab)
     # The conventions named anywhere bound and allow; only those named outside a negation must be done.
-    named = _named(_WORD.findall(text), vocab)
+    named = _named(WORD.findall(text), vocab)
     doubts: list[Doubt] = []
-    doubts += _parts(plan, vocab, words, set(_WORD.findall(negated)), named, profile,
+    doubts += _parts(plan, vocab, words, set(WORD.findall(negated)), named, profile,
                      _asked_by_unlisted_verbs(affirmed, vocab) | _points_asked(affirmed, plan, vocab),
                      _asked_by_command_verbs(affirmed, vocab))
     doubts += _directions(plan, vocab, words, named, profile)
@@ -170,7 +127,7 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     doubts += _ways_gone(affirmed, plan, vocab)
     doubts += _cancelled(text, plan, vocab, profile)
     doubts += _only(affirmed, plan, vocab, named, profile)
-    affirmed_named = _named(_WORD.findall(affirmed), vocab)
+    affirmed_named = _named(WORD.findall(affirmed), vocab)
     doubts += _carried_out(affirmed_named, text, plan, vocab)
     doubts += _one_object(named, plan)
     doubts += _negated_done([c for c in named if c not in affirmed_named], plan, vocab)
@@ -181,7 +138,7 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     return tuple({d.reason: d for d in doubts}.values())
 
 
-def _words(text: str, vocab: _Vocabulary) -> set[str]:
+def _words(text: str, vocab: Vocabulary) -> set[str]:
     """The task's words, with a pair that spells a skill word joined: "back up" is `backup`, "pick up" `pickup`.
 
     A part's noun that starts a clause is a verb there ("head over to the
@@ -190,14 +147,14 @@ def _words(text: str, vocab: _Vocabulary) -> set[str]:
     after another part's verb say how that part moves ("look straight
     ahead"), not that the robot drives.
     """
-    tokens = _WORD.findall(text)
+    tokens = WORD.findall(text)
     verbs = Counter(m.group(1) for m in _CLAUSE_START.finditer(text) if m.group(1) in vocab.noun_parts)
     said = Counter(t for t, how in zip(tokens, _ways_of_parts(tokens, vocab), strict=True) if not how)
     return ({t for t in said if verbs[t] < said[t]} | ({WHOLE} if verbs else set())
             | {a + b for a, b in itertools.pairwise(tokens) if a + b in vocab.skill_words})
 
 
-def _ways_of_parts(tokens: list[str], vocab: _Vocabulary) -> list[bool]:
+def _ways_of_parts(tokens: list[str], vocab: Vocabulary) -> list[bool]:
     """For each token, whether it is a word of the whole robot said of another part's motion."""
     whole = vocab.part_words.get(WHOLE, frozenset())
     how = [False] * len(tokens)
@@ -209,7 +166,7 @@ def _ways_of_parts(tokens: list[str], vocab: _Vocabulary) -> list[bool]:
     return how
 
 
-def _asked_by_unlisted_verbs(text: str, vocab: _Vocabulary) -> set[str]:
+def _asked_by_unlisted_verbs(text: str, vocab: Vocabulary) -> set[str]:
     """The parts asked for by a verb the profile does not list, told by the way and amount after it.
 
     "scoot back 1 m", "roll forward a little": a word that starts a clause
@@ -228,7 +185,7 @@ def _asked_by_unlisted_verbs(text: str, vocab: _Vocabulary) -> set[str]:
     return found
 
 
-def _asked_by_command_verbs(text: str, vocab: _Vocabulary) -> set[str]:
+def _asked_by_command_verbs(text: str, vocab: Vocabulary) -> set[str]:
     """The steps a whole command's own verb asks for, told by the way after it.
 
     "face left": the word that starts a whole command of the profile ("face
@@ -240,13 +197,13 @@ def _asked_by_command_verbs(text: str, vocab: _Vocabulary) -> set[str]:
     found: set[str] = set()
     for m in _CLAUSE_START.finditer(text):
         parts = vocab.command_verbs.get(m.group(1))
-        way = _NEXT_WORD.match(text, m.end(1)) if parts else None
+        way = _NEXTWORD.match(text, m.end(1)) if parts else None
         if parts and way:
             found |= {k for k in vocab.way_skills.get(way.group(1), ()) if vocab.parts.get(k, WHOLE) in parts}
     return found
 
 
-def _points_asked(text: str, plan: Plan, vocab: _Vocabulary) -> set[str]:
+def _points_asked(text: str, plan: Plan, vocab: Vocabulary) -> set[str]:
     """The parts of the steps that go to a point said whole, whatever verb carries it ("proceed to
     the point 4, 1", "I need you over at 3, -2"): a person names a point to have the robot go there."""
     said = [(float(x), float(y)) for x, y in _POINT.findall(text)]
@@ -259,7 +216,7 @@ def _points_asked(text: str, plan: Plan, vocab: _Vocabulary) -> set[str]:
     return found
 
 
-def _stem(stem: str, vocab: _Vocabulary) -> str:
+def _stem(stem: str, vocab: Vocabulary) -> str:
     """The verb of an "-ing" form with "ing" cut off: "back" (backing), "drive" (driv), "grab" (grabb).
 
     It is read after "to", as a verb starting a clause, so an unlisted verb
@@ -269,173 +226,12 @@ def _stem(stem: str, vocab: _Vocabulary) -> str:
     return next((w for w in (stem, undoubled, stem + "e") if w in vocab.known_words), undoubled)
 
 
-def skill_words(profile: Profile) -> frozenset[str]:
-    """The words of the robot's skills (keywords, aliases, directions): never a thing's name."""
-    return _vocabulary(profile).skill_words
-
-
-def skill_parts(profile: Profile) -> dict[str, str]:
-    """Which part of the robot each skill moves: the part its description's first clause names.
-
-    The parts are the nouns of the robot's description ("a wheeled base, a
-    pan-tilt head with a camera, and a gripper"); a part "with" another (the
-    camera) belongs to it. A skill naming none moves the robot as a whole.
-    """
-    return dict(_vocabulary(profile).parts)
-
-
-def _robot_parts(profile: Profile) -> dict[str, str]:
-    """Part noun -> the part it belongs to: {"base": "base", "head": "head", "camera": "head", ...}."""
-    nouns: dict[str, str] = {}
-    for piece in re.split(r",|\band\b", profile.description.split(":", 1)[-1]):
-        owner, _, sub = piece.partition(" with ")
-        head_words = _WORD.findall(owner)
-        if not head_words:
-            continue
-        part = head_words[-1]
-        nouns[part] = part
-        sub_words = _WORD.findall(sub)
-        if sub_words:
-            nouns[sub_words[-1]] = part
-    nouns.setdefault(WHOLE, WHOLE)
-    return nouns
-
-
-def _build_vocabulary(profile: Profile) -> _Vocabulary:
-    nouns = _robot_parts(profile)
-    parts: dict[str, str] = {}
-    words: dict[str, set[str]] = {}
-    for skill in profile.skills:
-        clause = _FIRST_CLAUSE.split(skill.description, 1)[0].lower()
-        named = [nouns[w] for w in _WORD.findall(clause) if w in nouns]
-        part = named[0] if named else WHOLE
-        parts[skill.keyword] = part
-        verb = _WORD.findall(clause)[:1]
-        words.setdefault(part, set()).update({skill.keyword, *skill.aliases, *verb})
-    for noun, part in nouns.items():
-        words.setdefault(part, set()).add(noun)
-    # A shape ("walk a square") is traced by driving.
-    words.setdefault(WHOLE, set()).update(_SHAPES)
-    # A word several parts share ("right" in turnright and lookright) tells no part apart.
-    counted: dict[str, int] = {}
-    for found in words.values():
-        for word in found:
-            counted[word] = counted.get(word, 0) + 1
-    for keyword, part in parts.items():
-        for other, other_part in parts.items():
-            if other_part == part:
-                continue
-            for word in list(words[part]):
-                if len(word) >= 2 and word != keyword and word in other and word not in words[other_part]:
-                    counted[word] = counted.get(word, 0) + 1
-    directions = []
-    for skill in profile.skills:
-        opposite = profile.skill(skill.opposite) if skill.opposite else None
-        if opposite is not None and skill.keyword < opposite.keyword:
-            mine, theirs = _difference(skill.keyword, opposite.keyword)
-            # "for" tells forward from backward but is no direction a person says; the keyword is.
-            mine = mine if mine in skill.aliases else skill.keyword
-            theirs = theirs if theirs in opposite.aliases else opposite.keyword
-            directions.append((skill.keyword, frozenset({mine}), opposite.keyword, frozenset({theirs})))
-    # A direction ("up" in "pick up the cup") says which way, not which part.
-    direction_words = {w for d in directions for w in (*d[1], *d[3])}
-    part_words = {p: frozenset(w for w in ws if counted[w] == 1 and "_" not in w and w not in direction_words)
-                  for p, ws in words.items()}
-    # "pan left then right" says the head's ways in the words the base's turns are told apart by. The
-    # keyword itself is no way: "look" would be said of both, as its inflections' prefix.
-    ways = []
-    for skill_keyword, mine_words, opposite_keyword, theirs_words in directions:
-        mine_raw, theirs_raw = _difference(skill_keyword, opposite_keyword)
-        ways.append((skill_keyword, frozenset({mine_raw} & direction_words) or mine_words,
-                     opposite_keyword, frozenset({theirs_raw} & direction_words) or theirs_words))
-
-    coordinates = frozenset(s.keyword for s in profile.skills if any(p.is_coordinate for p in s.params))
-    numbers: dict[str, set[float]] = {}
-    conventions = []
-    for convention in profile.conventions:
-        plan = compile_program(convention.program, profile).plan if convention.program else None
-        values: dict[str, set[float]] = {}
-        for command in plan or ():
-            if command.skill in coordinates:
-                continue
-            for arg in command.args:
-                if isinstance(arg, Quantity):
-                    values.setdefault(arg.unit, set()).add(abs(arg.value))
-        for value, unit in _NUMBER_UNIT.findall(convention.meaning):
-            if unit:
-                values.setdefault(unit, set()).add(abs(float(value)))
-        for unit, unit_values in values.items():
-            numbers.setdefault(unit, set()).update(unit_values)
-        whole = convention.whole_command
-        objects = [(c.skill, tuple(a.name for a in c.args if isinstance(a, ObjectRef))) for c in plan or ()]
-        same_object = frozenset((a, b) for (a, x), (b, y) in itertools.pairwise(objects) if x and x == y)
-        conventions.append(_Convention(
-            phrase=convention.phrase, words=tuple(_WORD.findall(convention.phrase.lower())),
-            meaning=convention.meaning, amounts={u: frozenset(v) for u, v in values.items()},
-            default=not whole and convention.phrase not in convention.task,
-            skills=frozenset(c.skill for c in plan or ()), whole=whole, same_object=same_object))
-    opposites = {s.keyword: s.opposite for s in profile.skills if s.opposite}
-    opposites.update({o: k for k, o in list(opposites.items())})
-    # A way ("right") or a short word ("go", "up") asks for no step of its own.
-    step_words = {s.keyword: frozenset(w for w in (s.keyword, *s.aliases,
-                                                   *_WORD.findall(_FIRST_CLAUSE.split(s.description, 1)[0].lower())[:1])
-                                       if len(w) >= 4 and "_" not in w and w not in direction_words)
-                  for s in profile.skills}
-    way_skills: dict[str, set[str]] = {}
-    for skill_keyword, mine_words, opposite_keyword, theirs_words in ways:
-        for keyword, said in ((skill_keyword, mine_words), (opposite_keyword, theirs_words)):
-            for way in said:
-                way_skills.setdefault(way, set()).add(keyword)
-    skill_word_set = frozenset({w for ws in words.values() for w in ws} - set(nouns) | direction_words)
-    known_words = skill_word_set | frozenset(nouns) | FUNCTION_WORDS
-    command_verbs: dict[str, set[str]] = {}
-    for c in conventions:
-        if c.whole and c.words and c.words[0] not in known_words:
-            command_verbs.setdefault(c.words[0], set()).update(parts.get(k, WHOLE) for k in c.skills)
-    amount_phrases = "|".join(re.escape(c.phrase) for c in conventions if c.amounts and not c.whole and not c.default)
-    return _Vocabulary(parts=parts, part_words=part_words, directions=tuple(ways),
-                       convention_numbers={u: frozenset(v) for u, v in numbers.items()},
-                       conventions=tuple(conventions), coordinates=coordinates,
-                       skill_words=skill_word_set, noun_parts=nouns, opposites=opposites,
-                       step_words=step_words, way_skills={w: frozenset(k) for w, k in way_skills.items()},
-                       part_verbs=frozenset(w for p, ws in part_words.items() if p != WHOLE for w in ws) - set(nouns),
-                       known_words=known_words,
-                       way_and_amount=re.compile(rf"\s+([a-z]+)\s+(?:\d*\.?\d+|{amount_phrases})\b"),
-                       command_verbs={w: frozenset(ps) for w, ps in command_verbs.items()})
-
-
-_VOCABULARIES: dict[tuple[str, str], _Vocabulary] = {}
-
-
-def _vocabulary(profile: Profile) -> _Vocabulary:
-    # The language digest leaves out the robot's description, which an adapter never learned but the
-    # parts are read from.
-    key = (profile.digest, profile.description)
-    found = _VOCABULARIES.get(key)
-    if found is None:
-        found = _VOCABULARIES[key] = _build_vocabulary(profile)
-    return found
-
-
-def _difference(a: str, b: str) -> tuple[str, str]:
-    """What tells two keywords apart: turnleft/turnright -> left/right; forward/backward stay whole."""
-    start = 0
-    while start < min(len(a), len(b)) and a[start] == b[start]:
-        start += 1
-    end = 0
-    while end < min(len(a), len(b)) - start and a[-1 - end] == b[-1 - end]:
-        end += 1
-    start = start if start >= 3 else 0
-    end = end if end >= 3 else 0
-    return a[start:len(a) - end], b[start:len(b) - end]
-
-
 def _said(words: Iterable[str], direction: frozenset[str]) -> bool:
     return any(w == d or (len(w) >= 4 and d.startswith(w)) or (len(d) >= 4 and w.startswith(d))
                for w in words for d in direction)
 
 
-def _parts(plan: Plan, vocab: _Vocabulary, words: set[str], negated: set[str], named: list[_Convention],
+def _parts(plan: Plan, vocab: Vocabulary, words: set[str], negated: set[str], named: list[ConventionReading],
            profile: Profile, also_asked: set[str], steps_asked: set[str]) -> list[Doubt]:
     """The base moves only when asked for motion; a request about the head moves only the head."""
     used = {vocab.parts.get(c.skill, WHOLE) for c in plan}
@@ -459,7 +255,7 @@ def _parts(plan: Plan, vocab: _Vocabulary, words: set[str], negated: set[str], n
     return doubts
 
 
-def _directions(plan: Plan, vocab: _Vocabulary, words: set[str], named: list[_Convention],
+def _directions(plan: Plan, vocab: Vocabulary, words: set[str], named: list[ConventionReading],
                 profile: Profile) -> list[Doubt]:
     """The plan goes the way that was said, and goes both ways only when both were said.
 
@@ -487,7 +283,7 @@ def _directions(plan: Plan, vocab: _Vocabulary, words: set[str], named: list[_Co
 def _said_numbers(text: str) -> list[tuple[float, str]]:
     """The amounts said, less counts ("3 times") and numbers taken back ("1 m, no, 2 m")."""
     dropped = {m.start(1) for m in _COUNT.finditer(text)} | {m.start(1) for m in _TAKEN_BACK_NUMBER.finditer(text)}
-    return [(abs(float(m.group(1))), m.group(2) or "") for m in _NUMBER_UNIT.finditer(text)
+    return [(abs(float(m.group(1))), m.group(2) or "") for m in NUMBER_UNIT.finditer(text)
             if m.start(1) not in dropped]
 
 
@@ -509,7 +305,7 @@ def _close(a: float, b: float) -> bool:
     return abs(a - b) <= max(_TOLERANCE, 0.01 * abs(b))
 
 
-def _numbers(text: str, plan: Plan, vocab: _Vocabulary, profile: Profile) -> list[Doubt]:
+def _numbers(text: str, plan: Plan, vocab: Vocabulary, profile: Profile) -> list[Doubt]:
     """Every number said is in the plan; every number in the plan was said or is a convention's."""
     said = _said_numbers(text)
     planned = [(abs(a.value), a.unit, c) for c in plan for a in c.args if isinstance(a, Quantity)]
@@ -538,7 +334,7 @@ def _numbers(text: str, plan: Plan, vocab: _Vocabulary, profile: Profile) -> lis
     return doubts
 
 
-def _totals(text: str, plan: Plan, vocab: _Vocabulary, named: list[_Convention]) -> list[Doubt]:
+def _totals(text: str, plan: Plan, vocab: Vocabulary, named: list[ConventionReading]) -> list[Doubt]:
     """The whole turn and the whole drive of the base fit what was said."""
     count = _counts(text)
     said = _said_numbers(text)
@@ -611,7 +407,7 @@ def _repetitions(text: str, plan: Plan, profile: Profile) -> list[Doubt]:
     return [Doubt("repetitions", f"you said {said} times, but the plan does {block} {times} times")]
 
 
-def _restated(text: str, plan: Plan, vocab: _Vocabulary, profile: Profile) -> list[Doubt]:
+def _restated(text: str, plan: Plan, vocab: Vocabulary, profile: Profile) -> list[Doubt]:
     """Two amounts said one after the other, both done by back-to-back steps.
 
     "turn right 90 degrees, correction, 45 degrees" most likely takes the
@@ -624,7 +420,7 @@ def _restated(text: str, plan: Plan, vocab: _Vocabulary, profile: Profile) -> li
     doubts = []
     found = [(m, False) for m in _RESTATED.finditer(text)] + [(m, True) for m in _CORRECTED_AMOUNT.finditer(text)]
     for m, marked in found:
-        between = set(_WORD.findall(m.group(3)))
+        between = set(WORD.findall(m.group(3)))
         if between & _SEQUENCE_WORDS or (not marked and between & (vocab.skill_words | vocab.noun_parts.keys())):
             continue
         first, second, unit = float(m.group(1)), float(m.group(4)), m.group(2)
@@ -660,7 +456,7 @@ def _doubled(text: str, plan: Plan, profile: Profile) -> list[Doubt]:
         return [Doubt("doubled", f"the plan does the same step twice in a row ({say(a, profile)}), but you "
                                  "did not ask for it twice")]
     # Apart too: a step on a thing named once ("fetch the ball, then look around" going for the ball twice).
-    words = Counter(_WORD.findall(text))
+    words = Counter(WORD.findall(text))
     steps = [(c.skill, c.args) for c in plan]
     for at, command in enumerate(plan):
         names = [x.name for x in command.args if isinstance(x, ObjectRef)]
@@ -671,7 +467,7 @@ def _doubled(text: str, plan: Plan, profile: Profile) -> list[Doubt]:
     return []
 
 
-def _ways_gone(affirmed: str, plan: Plan, vocab: _Vocabulary) -> list[Doubt]:
+def _ways_gone(affirmed: str, plan: Plan, vocab: Vocabulary) -> list[Doubt]:
     """Every way said of a part the plan moves is a way it goes: "go right 2 m" is no straight drive.
 
     Only plans whose moving steps all have a way are read: a drive to an
@@ -686,8 +482,8 @@ def _ways_gone(affirmed: str, plan: Plan, vocab: _Vocabulary) -> list[Doubt]:
     moved = {vocab.parts.get(skill) for skill in moving}
     planned = {c.skill for c in plan}
     # "left, no, make that right" takes the first way back.
-    taken_back = {m.start(1) for m in _TAKEN_BACK_WORD.finditer(affirmed) if m.group(2) in ways}
-    tokens = ["", *(m.group(0) for m in _WORD.finditer(affirmed) if m.start() not in taken_back), ""]
+    taken_back = {m.start(1) for m in _TAKEN_BACKWORD.finditer(affirmed) if m.group(2) in ways}
+    tokens = ["", *(m.group(0) for m in WORD.finditer(affirmed) if m.start() not in taken_back), ""]
     doubts = []
     for before, token, after in zip(tokens, tokens[1:], tokens[2:], strict=False):
         # "pick up", "back up": the way is part of a word that names a step.
@@ -701,12 +497,12 @@ def _ways_gone(affirmed: str, plan: Plan, vocab: _Vocabulary) -> list[Doubt]:
     return list({d.reason: d for d in doubts}.values())
 
 
-def _cancelled(text: str, plan: Plan, vocab: _Vocabulary, profile: Profile) -> list[Doubt]:
+def _cancelled(text: str, plan: Plan, vocab: Vocabulary, profile: Profile) -> list[Doubt]:
     """A step whose last mention takes it back ("..., actually skip the turn") is not in the plan."""
     spans = [(m.start(), m.end(), m.group(0).strip()) for m in _CANCELLED.finditer(text)]
     if not spans:
         return []
-    mentions = [(m.start(), m.group(0)) for m in _WORD.finditer(text)]
+    mentions = [(m.start(), m.group(0)) for m in WORD.finditer(text)]
     steps: dict[str, list[int]] = {}
     for index, command in enumerate(plan):
         words = vocab.step_words.get(command.skill, frozenset())
@@ -718,7 +514,7 @@ def _cancelled(text: str, plan: Plan, vocab: _Vocabulary, profile: Profile) -> l
     return [Doubt("cancelled", reason, tuple(indices)) for reason, indices in steps.items()]
 
 
-def _only(affirmed: str, plan: Plan, vocab: _Vocabulary, named: list[_Convention], profile: Profile
+def _only(affirmed: str, plan: Plan, vocab: Vocabulary, named: list[ConventionReading], profile: Profile
           ) -> list[Doubt]:
     """A part said with "only" ("turn left, but only your head") is the only part that moves."""
     kept = {vocab.noun_parts[m.group(1)] for pattern in _ONLY for m in pattern.finditer(affirmed)
@@ -740,7 +536,7 @@ def _inflected(token: str, word: str) -> bool:
     return token == word or (token.startswith(word.rstrip("e")) and len(token) <= len(word) + 3)
 
 
-def _one_object(named: list[_Convention], plan: Plan) -> list[Doubt]:
+def _one_object(named: list[ConventionReading], plan: Plan) -> list[Doubt]:
     """Where a named convention acts on one thing in consecutive steps ("fetch"), the plan does too."""
     pairs = {pair for c in named for pair in c.same_object}
     doubts = []
@@ -753,7 +549,7 @@ def _one_object(named: list[_Convention], plan: Plan) -> list[Doubt]:
     return doubts
 
 
-def _negated_done(negated: list[_Convention], plan: Plan, vocab: _Vocabulary) -> list[Doubt]:
+def _negated_done(negated: list[ConventionReading], plan: Plan, vocab: Vocabulary) -> list[Doubt]:
     """A convention said only to deny it ("no need to look around") is not carried out."""
     planned = _amounts(plan, vocab)
     skills = {c.skill for c in plan}
@@ -773,7 +569,7 @@ def _negated_done(negated: list[_Convention], plan: Plan, vocab: _Vocabulary) ->
 _PHRASE_GAP = 3
 
 
-def _names(tokens: list[str], convention: _Convention, vocab: _Vocabulary) -> bool:
+def _names(tokens: list[str], convention: ConventionReading, vocab: Vocabulary) -> bool:
     """Whether the task's words name `convention`: its words in order, a few others between.
 
     A word between that asks for a step of its own breaks the phrase: "turn
@@ -800,12 +596,12 @@ def _same(token: str, word: str) -> bool:
     return token == word or (len(word) >= 5 and token.startswith(word.rstrip("e")))
 
 
-def _named(tokens: list[str], vocab: _Vocabulary) -> list[_Convention]:
+def _named(tokens: list[str], vocab: Vocabulary) -> list[ConventionReading]:
     """The conventions these words name."""
     return [c for c in vocab.conventions if _names(tokens, c, vocab)]
 
 
-def _carried_out(named: list[_Convention], text: str, plan: Plan, vocab: _Vocabulary) -> list[Doubt]:
+def _carried_out(named: list[ConventionReading], text: str, plan: Plan, vocab: Vocabulary) -> list[Doubt]:
     """A convention the task names is done: a whole command's skills (or their opposites), and its amount.
 
     The amount is looked for only in units the task gives no number in, and
@@ -832,18 +628,18 @@ def _carried_out(named: list[_Convention], text: str, plan: Plan, vocab: _Vocabu
     return doubts
 
 
-def _amounts(plan: Plan, vocab: _Vocabulary) -> list[tuple[float, str]]:
+def _amounts(plan: Plan, vocab: Vocabulary) -> list[tuple[float, str]]:
     """The amounts the plan's steps take, without sign, less positions."""
     return [(abs(a.value), a.unit) for c in plan if c.skill not in vocab.coordinates
             for a in c.args if isinstance(a, Quantity)]
 
 
-def _conventions_said(named: list[_Convention], unit: str) -> float:
+def _conventions_said(named: list[ConventionReading], unit: str) -> float:
     """What the conventions named in the task add ("then turn around": 180°)."""
     return sum(max(c.amounts.get(unit, (0.0,))) for c in named)
 
 
-def _vague_amount(named: list[_Convention], vocab: _Vocabulary, unit: str) -> float:
+def _vague_amount(named: list[ConventionReading], vocab: Vocabulary, unit: str) -> float:
     """The most a task that says no number may mean: its conventions' amounts, else the defaults'."""
     used = [c.amounts for c in named] or [c.amounts for c in vocab.conventions if c.default]
     return max((v for values in used for v in values.get(unit, ())), default=0.0)
@@ -855,12 +651,12 @@ _REFERS_BACK = re.compile(r"\b(?:it|them|there)\b")
 _CORRECTING = frozenset(m.split()[0] for m in MARKERS)
 
 
-def _objects(text: str, affirmed_text: str, plan: Plan, known: Collection[str] | None, vocab: _Vocabulary
+def _objects(text: str, affirmed_text: str, plan: Plan, known: Collection[str] | None, vocab: Vocabulary
              ) -> list[Doubt]:
     """Every object in the plan was said, and every known object said is in the plan."""
     known_words = {w for name in known or () for w in name.lower().split("_")}
-    taken_back = {m.group(1) for m in _TAKEN_BACK_WORD.finditer(text) if m.group(2) in known_words}
-    words = set(_WORD.findall(text))
+    taken_back = {m.group(1) for m in _TAKEN_BACKWORD.finditer(text) if m.group(2) in known_words}
+    words = set(WORD.findall(text))
     # "not the chair" denies an object; "no, the keys" corrects to one. "don't grab the mug, just go to it"
     # denies a step the plan leaves out, and the rest says the thing again.
     denied: set[str] = set()
@@ -868,7 +664,7 @@ def _objects(text: str, affirmed_text: str, plan: Plan, known: Collection[str] |
     said_again = _REFERS_BACK.search(affirmed_text) is not None
 
     def deny(m: re.Match[str]) -> str:
-        said = _WORD.findall(m.group(0))
+        said = WORD.findall(m.group(0))
         steps = {skill for skill, step_words in vocab.step_words.items()
                  if any(_inflected(token, w) for token in said for w in step_words)}
         if said[0] in _CORRECTING or (said_again and steps and not steps & planned_skills):
@@ -876,7 +672,7 @@ def _objects(text: str, affirmed_text: str, plan: Plan, known: Collection[str] |
         denied.update(said)
         return " "
 
-    affirmed = set(_WORD.findall(_NEGATION.sub(deny, text)))
+    affirmed = set(WORD.findall(_NEGATION.sub(deny, text)))
     planned = {a.name for c in plan for a in c.args if isinstance(a, ObjectRef)}
     doubts = []
     for name in sorted(planned):

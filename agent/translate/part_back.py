@@ -11,7 +11,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from agent.translate.meaning import skill_parts
+from agent.translate.vocabulary import skill_parts
 from rsl.plan import Plan, Quantity, format_number
 from rsl.profile import Profile
 

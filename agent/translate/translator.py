@@ -26,7 +26,7 @@ from agent.translate.clauses import Clause, split_clauses
 from agent.translate.confidence import Assessment, assess, model_signal, result_fields, with_doubt
 from agent.translate.engine import FORK_RECORD_FLOOR, CancelFlag, Fork, Generation
 from agent.translate.explain import explain
-from agent.translate.meaning import Doubt, skill_words
+from agent.translate.meaning import Doubt
 from agent.translate.model_path import ModelNotFoundError
 from agent.translate.names import DETERMINERS, FUNCTION_WORDS, NOT_NAMES, offered_names
 from agent.translate.part_back import PutBack, put_back, undoing
@@ -40,6 +40,7 @@ from agent.translate.prompt import (
     system_text,
 )
 from agent.translate.result import Attempt, TranslationResult
+from agent.translate.vocabulary import skill_words
 from rsl.compiler import compile_program
 from rsl.diagnostics import Code, Diagnostic
 from rsl.plan import Plan, Quantity, format_number

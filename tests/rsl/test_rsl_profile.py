@@ -103,7 +103,10 @@ def test_profile_settings_are_checked_like_every_other_setting(patch, replacemen
 
 
 @pytest.mark.parametrize(("table", "complaint"), [
-    ('part = "tail"\nphrases = ["tail back"]', "part 'tail' is not named"),
+    ('part = "tail"\nphrases = ["tail back"]',
+     r"part 'tail' is not a part the robot's description names \(its parts: base, gripper, head\)"),
+    # The camera is the head's: the head's skills move it, so only "head" would ever be put back.
+    ('part = "camera"\nphrases = ["camera back"]', "part 'camera' is not a part"),
     ('part = "head"\nphrases = []', "needs `part`"),
     ('phrases = ["head back"]', "needs `part`"),
 ])

@@ -10,7 +10,8 @@ import pytest
 from agent.normalize import normalize_task
 from agent.translate.confidence import UNSURE_BELOW, assess
 from agent.translate.explain import capabilities, explain
-from agent.translate.meaning import check_meaning, skill_parts
+from agent.translate.meaning import check_meaning
+from agent.translate.vocabulary import skill_parts
 from rsl.compiler import compile_program
 from rsl.plan import Plan
 from rsl.profile import Profile, load_profile, parse_profile
