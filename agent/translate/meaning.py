@@ -53,6 +53,9 @@ _NEXTWORD = re.compile(r"\s+([a-z]+)")
 # "would you mind turning left", "before grabbing the cup": the "-ing" word after "mind", "before" or
 # "after" asks for the act. Elsewhere an "-ing" form may tell what was done ("nice job turning left").
 _ASKED_DOING = re.compile(r"\b(mind|before|after) ([a-z]{3,}?)ing\b")
+# "take a look", "get a picture": the verb only carries the noun, so it asks nothing of the gripper.
+_LIGHT_VERB = re.compile(r"\b(?:take|get|grab)\s+(?=(?:a|another)\s+(?:(?:quick|little|good|close)\s+)?"
+                         r"(?:look|peek|glance|picture|photo|snapshot|pic)\b)")
 # A point said whole: two numbers joined by a comma ("the point 3, -2").
 _POINT = re.compile(r"(?<![\w.])(-?\d*\.?\d+), (-?\d*\.?\d+)(?![\w.])")
 # Two amounts in one unit with only a comma and a few words between: the second may correct the first
@@ -106,7 +109,8 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
                   ) -> tuple[Doubt, ...]:
     """Every disagreement between the normalized `task` and `plan`; empty when they agree."""
     vocab = vocabulary(profile)
-    text = _ASKED_DOING.sub(lambda m: f"{m.group(1)} to {_stem(m.group(2), vocab)}", task.lower())
+    text = _ASKED_DOING.sub(lambda m: f"{m.group(1)} to {_stem(m.group(2), vocab)}",
+                            _LIGHT_VERB.sub("", task.lower()))
     # A bare "no" before a correction ("left, no, make that right") takes a word back, not the clause.
     negated = " ".join(m.group(0) for m in _NEGATION.finditer(text) if m.group(0).strip() not in MARKERS)
     affirmed = _NEGATION.sub(lambda m: m.group(0) if m.group(0).strip() in MARKERS else " ", text)

@@ -182,6 +182,10 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
      "you asked about the head, but the plan moves the base (drive forward 1 m)"),
     ("before grabbing the ball, drive up to it", "approach ball;",
      "you asked about the gripper, but the plan never uses it"),
+    # "take" asks about the gripper, but not in "take a look".
+    ("take the cup", "perceive;", "you asked about the gripper, but the plan never uses it"),
+    ("take a look to your left", "turnleft 1.5708;",
+     "you asked about the head, but the plan moves the base (turn left 90°)"),
     # Only the point said asks for the drive there.
     ("proceed to the point 4, 1", "goto 1, 4;",
      "you did not ask the robot to move, but the plan does (drive to the point (1 m, 4 m))"),
@@ -307,6 +311,9 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     # So does "before" or "after" with one.
     ("before grabbing the spoon, drive up to it", "approach spoon; grasp spoon;"),
     ("peek up a little", "lookup 0.2618;"),
+    # A light verb carries the noun of looking and asks nothing of the gripper.
+    ("take a look with your camera", "perceive;"),
+    ("look up, then take a quick picture", "lookup 0.5236; perceive;"),
     ("go to the table, look around, and come back to the table",
      "approach table; lookleft 1.5708; perceive; lookright 3.1416; perceive; lookleft 1.5708; approach table;"),
     # Words of driving after the verb of driving ask for it.
