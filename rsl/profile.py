@@ -337,8 +337,8 @@ def _build(data: dict[str, Any], source: str) -> Profile:
                     raise fail(f"[[cannot]] phrase {phrase!r} is a word for the skill `{skill.keyword}`")
         cannot.append(Inability(what=what, phrases=phrases))
     back = []
+    parts = sorted(set(part_nouns(str(robot.get("description", ""))).values()))
     for index, part, phrases in _phrase_tables(data, "back", "part", "a part of the robot", fail):
-        parts = sorted(set(part_nouns(str(robot.get("description", ""))).values()))
         if part.lower() not in parts:
             raise fail(f"[[back]] #{index}: part {part!r} is not a part the robot's description names "
                        f"(its parts: {', '.join(parts)})")
@@ -361,7 +361,6 @@ def _build(data: dict[str, Any], source: str) -> Profile:
         cannot=tuple(cannot),
         back=tuple(back),
     )
-
 
 
 def part_nouns(description: str) -> dict[str, str]:
@@ -395,6 +394,7 @@ def _phrase_tables(data: dict[str, Any], table: str, key: str, shape: str,
                 or not all(isinstance(p, str) and p.strip() for p in phrases)):
             raise fail(f"[[{table}]] #{index} needs `{key}` ({shape}) and `phrases` (a list of words)")
         yield index, value, tuple(p.strip().lower() for p in phrases)
+
 
 # What a skill's statement is and means; bindings, spoken wording and the
 # like say how the robot does it or tells it, not what the adapter learned.

@@ -45,11 +45,11 @@ _CORRECTED = rf"(?:,?\s+(?:{'|'.join(MARKERS)}))+,?\s+(?:the |a |an )?"
 _TAKEN_BACK_NUMBER = re.compile(rf"(?<![\w.])(-?\d*\.?\d+)(?: (m|rad)\b)?{_CORRECTED}"
                                 r"(?=(?:(?!(?:and|then|after|next|also)\b)[a-z']+,? ){0,4}?-?\d*\.?\d+"
                                 r"(?(2) \2\b|(?! (?:m|rad)\b)))")
-_TAKEN_BACKWORD = re.compile(rf"\b([a-z]+){_CORRECTED}([a-z]+)")
+_TAKEN_BACK_WORD = re.compile(rf"\b([a-z]+){_CORRECTED}([a-z]+)")
 # An amount taken back by a marker and said again, with its step or without ("back up 1 m, scratch that,
 # back up 0.5 m").
 _CORRECTED_AMOUNT = re.compile(rf"(?<![\w.])(\d*\.?\d+) (m|rad){_CORRECTED}((?:[a-z']+,? ){{0,4}}?)(\d*\.?\d+) \2\b")
-_NEXTWORD = re.compile(r"\s+([a-z]+)")
+_NEXT_WORD = re.compile(r"\s+([a-z]+)")
 # "would you mind turning left", "before grabbing the cup": the "-ing" word after "mind", "before" or
 # "after" asks for the act. Elsewhere an "-ing" form may tell what was done ("nice job turning left").
 _ASKED_DOING = re.compile(r"\b(mind|before|after) ([a-z]{3,}?)ing\b")
@@ -201,7 +201,7 @@ def _asked_by_command_verbs(text: str, vocab: Vocabulary) -> set[str]:
     found: set[str] = set()
     for m in _CLAUSE_START.finditer(text):
         parts = vocab.command_verbs.get(m.group(1))
-        way = _NEXTWORD.match(text, m.end(1)) if parts else None
+        way = _NEXT_WORD.match(text, m.end(1)) if parts else None
         if parts and way:
             found |= {k for k in vocab.way_skills.get(way.group(1), ()) if vocab.parts.get(k, WHOLE) in parts}
     return found
@@ -486,7 +486,7 @@ def _ways_gone(affirmed: str, plan: Plan, vocab: Vocabulary) -> list[Doubt]:
     moved = {vocab.parts.get(skill) for skill in moving}
     planned = {c.skill for c in plan}
     # "left, no, make that right" takes the first way back.
-    taken_back = {m.start(1) for m in _TAKEN_BACKWORD.finditer(affirmed) if m.group(2) in ways}
+    taken_back = {m.start(1) for m in _TAKEN_BACK_WORD.finditer(affirmed) if m.group(2) in ways}
     tokens = ["", *(m.group(0) for m in WORD.finditer(affirmed) if m.start() not in taken_back), ""]
     doubts = []
     for before, token, after in zip(tokens, tokens[1:], tokens[2:], strict=False):
@@ -659,7 +659,7 @@ def _objects(text: str, affirmed_text: str, plan: Plan, known: Collection[str] |
              ) -> list[Doubt]:
     """Every object in the plan was said, and every known object said is in the plan."""
     known_words = {w for name in known or () for w in name.lower().split("_")}
-    taken_back = {m.group(1) for m in _TAKEN_BACKWORD.finditer(text) if m.group(2) in known_words}
+    taken_back = {m.group(1) for m in _TAKEN_BACK_WORD.finditer(text) if m.group(2) in known_words}
     words = set(WORD.findall(text))
     # "not the chair" denies an object; "no, the keys" corrects to one. "don't grab the mug, just go to it"
     # denies a step the plan leaves out, and the rest says the thing again.

@@ -27,6 +27,8 @@ _FIRST_CLAUSE = re.compile(r"[.;]")
 
 @dataclass(frozen=True)
 class Vocabulary:
+    """What the checks know of a robot's words, built once per profile by `vocabulary`."""
+
     parts: dict[str, str]  # skill keyword -> part ("base", "head", "gripper")
     part_words: dict[str, frozenset[str]]  # part -> words that name it or its skills, unshared
     directions: tuple[tuple[str, frozenset[str], str, frozenset[str]], ...]  # (skill, way, opposite, way)
@@ -184,6 +186,7 @@ _VOCABULARIES: dict[tuple[str, str], Vocabulary] = {}
 
 
 def vocabulary(profile: Profile) -> Vocabulary:
+    """The words of `profile`'s robot, read once and kept."""
     # The language digest leaves out the robot's description, which an adapter never learned but the
     # parts are read from.
     key = (profile.digest, profile.description)
