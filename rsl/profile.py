@@ -25,7 +25,8 @@ from rsl.settings import read_settings, setting
 IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 SKILL_KEYWORD = re.compile(r"[a-z][a-z0-9_]*\Z")
 _AMOUNT = re.compile(r"\d\s*[a-z]+\b")
-_LOWER_WORD = re.compile(r"[a-z]+")
+# A lower-case word, as the robot's description and a normalized task are read.
+WORD = re.compile(r"[a-z]+")
 # The part of the robot that moves itself as a whole: the one a skill is on when its description names no part.
 WHOLE = "base"
 
@@ -373,12 +374,12 @@ def part_nouns(description: str) -> dict[str, str]:
     nouns: dict[str, str] = {}
     for piece in re.split(r",|\band\b", description.split(":", 1)[-1]):
         owner, _, sub = piece.partition(" with ")
-        owner_words = _LOWER_WORD.findall(owner)
+        owner_words = WORD.findall(owner)
         if not owner_words:
             continue
         part = owner_words[-1]
         nouns[part] = part
-        sub_words = _LOWER_WORD.findall(sub)
+        sub_words = WORD.findall(sub)
         if sub_words:
             nouns[sub_words[-1]] = part
     nouns.setdefault(WHOLE, WHOLE)

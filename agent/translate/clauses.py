@@ -39,8 +39,8 @@ class Clause:
 
 
 # A regular polygon is its sides repeated: drive a side, turn 2*pi/N.
-_SHAPES = {"triangle": 3, "square": 4, "pentagon": 5, "hexagon": 6, "octagon": 8}
-_SHAPE = re.compile(r"\b(?:a |an )?(" + "|".join(_SHAPES) + r")\b")
+SHAPES = {"triangle": 3, "square": 4, "pentagon": 5, "hexagon": 6, "octagon": 8}
+_SHAPE = re.compile(r"\b(?:a |an )?(" + "|".join(SHAPES) + r")\b")
 _LENGTH = re.compile(r"(\d*\.?\d+) m\b")
 
 
@@ -61,7 +61,7 @@ def split_clauses(task: str, profile: Profile) -> list[Clause]:
             last_object = named[-1]
         shape = _SHAPE.search(part)
         if shape is not None:
-            clauses.extend(_polygon(part, _SHAPES[shape.group(1)]))
+            clauses.extend(_polygon(part, SHAPES[shape.group(1)]))
             continue
         repeat_all = _REPEAT_ALL.match(part)
         if repeat_all and clauses:

@@ -23,7 +23,7 @@ from collections.abc import Collection, Iterable
 from dataclasses import dataclass
 
 from agent.corrections import MARKERS
-from agent.translate.clauses import _SHAPES
+from agent.translate.clauses import SHAPES
 from agent.translate.explain import quantity, say
 from agent.translate.names import DETERMINERS
 from agent.translate.vocabulary import NUMBER_UNIT, WHOLE, WORD, ConventionReading, Vocabulary, vocabulary
@@ -302,7 +302,7 @@ def _counts(text: str) -> int:
 
 def _sides_said(text: str) -> list[int]:
     """The sides of each shape the task names ("walk a square": 4)."""
-    return [sides for shape, sides in _SHAPES.items() if re.search(rf"\b{shape}\b", text)]
+    return [sides for shape, sides in SHAPES.items() if re.search(rf"\b{shape}\b", text)]
 
 
 def _close(a: float, b: float) -> bool:
@@ -320,7 +320,7 @@ def _numbers(text: str, plan: Plan, vocab: Vocabulary, profile: Profile) -> list
             shown = quantity(Quantity(value, unit)) if unit else f"{value:g}"
             doubts.append(Doubt("number", f"you said {shown}, but the plan never uses it"))
     count = _counts(text)
-    shape_turns = {2 * math.pi / n for n in _SHAPES.values()}
+    shape_turns = {2 * math.pi / n for n in SHAPES.values()}
     for value, unit, command in amounts:
         said_here = [v for v, u in said if not u or u == unit]
         if any(_close(value, v * k) for v in said_here for k in range(1, count + 1)):

@@ -8,6 +8,7 @@ plan, so the steps are worked out from the skills' opposites instead.
 
 from __future__ import annotations
 
+import functools
 import re
 from dataclasses import dataclass
 
@@ -36,9 +37,7 @@ def put_back(task: str, profile: Profile) -> PutBack | None:
     """The part a normalized task's last clause puts back, with the text before it; None when it puts
     none back or says nothing before it (then there is nothing to undo, and the task is read whole)."""
     for back in profile.back:
-        # Longest first, so "look straight ahead again" is read whole where "look straight ahead" would do.
-        phrases = "|".join(re.escape(p) for p in sorted(back.phrases, key=len, reverse=True))
-        for found in re.finditer(rf"\b(?:{phrases})\b", task):
+        for found in _said(back.phrases).finditer(task):
             if not _TRAILING.fullmatch(task, found.end()):
                 continue
             breaks = list(_CLAUSE_BREAK.finditer(task, 0, found.start()))
@@ -46,6 +45,14 @@ def put_back(task: str, profile: Profile) -> PutBack | None:
             if before:
                 return PutBack(before=before, part=back.part, phrase=found.group(0))
     return None
+
+
+@functools.cache
+def _said(phrases: tuple[str, ...]) -> re.Pattern[str]:
+    """Where any of a `[[back]]` table's phrases is said."""
+    # Longest first, so "look straight ahead again" is read whole where "look straight ahead" would do.
+    alternatives = "|".join(re.escape(p) for p in sorted(phrases, key=len, reverse=True))
+    return re.compile(rf"\b(?:{alternatives})\b")
 
 
 def undoing(plan: Plan, part: str, profile: Profile) -> str:

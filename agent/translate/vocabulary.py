@@ -14,13 +14,12 @@ import itertools
 import re
 from dataclasses import dataclass
 
-from agent.translate.clauses import _SHAPES
+from agent.translate.clauses import SHAPES
 from agent.translate.names import FUNCTION_WORDS
 from rsl.compiler import compile_program
 from rsl.plan import ObjectRef, Quantity
-from rsl.profile import WHOLE, Profile, part_nouns
+from rsl.profile import WHOLE, WORD, Profile, part_nouns
 
-WORD = re.compile(r"[a-z]+")
 NUMBER_UNIT = re.compile(r"(?<![\w.])(-?\d*\.?\d+)(?: (m|rad)\b)?")
 _FIRST_CLAUSE = re.compile(r"[.;]")
 
@@ -93,7 +92,7 @@ def _build_vocabulary(profile: Profile) -> Vocabulary:
     for noun, part in nouns.items():
         words.setdefault(part, set()).add(noun)
     # A shape ("walk a square") is traced by driving.
-    words.setdefault(WHOLE, set()).update(_SHAPES)
+    words.setdefault(WHOLE, set()).update(SHAPES)
     # A word several parts share ("right" in turnright and lookright) tells no part apart.
     counted: dict[str, int] = {}
     for found in words.values():
