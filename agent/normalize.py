@@ -24,8 +24,8 @@ from rsl.plan import format_number
 _TOKEN = re.compile(r"\d*\.\d+|\d+|[a-z]+(?:'[a-z]+)?|°|,|[.!?;:]")
 
 _ONES = {
-    "zero": 0, "oh": 0, "one": 1, "two": 2, "three": 3, "four": 4, "five": 5, "six": 6, "seven": 7,
-    "eight": 8, "nine": 9, "ten": 10, "eleven": 11, "twelve": 12, "thirteen": 13, "fourteen": 14,
+    "zero": 0, "nought": 0, "naught": 0, "oh": 0, "one": 1, "two": 2, "three": 3, "four": 4, "five": 5,
+    "six": 6, "seven": 7, "eight": 8, "nine": 9, "ten": 10, "eleven": 11, "twelve": 12, "thirteen": 13, "fourteen": 14,
     "fifteen": 15, "sixteen": 16, "seventeen": 17, "eighteen": 18, "nineteen": 19,
 }
 _TENS = {"twenty": 20, "thirty": 30, "forty": 40, "fifty": 50, "sixty": 60, "seventy": 70,
@@ -53,6 +53,8 @@ _LENGTHS = {
     **dict.fromkeys(("yard", "yards", "yd"), 0.9144),
     **dict.fromkeys(("km", "kilometer", "kilometers", "kilometre", "kilometres"), 1000.0),
 }
+# A length's factor -> the factor of the unit a bare number right after it is in: centimetres, inches.
+_UNSAID_SMALLER = {1.0: 0.01, 0.3048: 0.0254}
 _ANGLES = {
     **dict.fromkeys(("degree", "degrees", "deg", "degs", "°"), math.pi / 180),
     **dict.fromkeys(("rad", "rads", "radian", "radians"), 1.0),
@@ -89,6 +91,7 @@ def normalize_task(text: str) -> str:
     """Normalize one task; see the module docstring for the output format."""
     tokens = _tokenize(text)
     tokens = _drop_fillers(tokens)
+    tokens = _hear_to(tokens)
     tokens = _carry_corrected_units(tokens)
     tokens = _carry_correcting_units(tokens)
     tokens = _convert_numbers(tokens)
@@ -119,6 +122,16 @@ def _drop_fillers(tokens: list[str]) -> list[str]:
             out.append(tokens[i])
             i += 1
     return out
+
+
+# A number is never followed by a determiner, so "go too the fridge" is "go to the fridge".
+_TO_HEARD_AS = frozenset({"two", "too"})
+_DETERMINERS = frozenset({"the", "your", "my", "its", "his", "her", "their", "our"})
+
+
+def _hear_to(tokens: list[str]) -> list[str]:
+    return ["to" if t in _TO_HEARD_AS and tokens[i + 1:i + 2] and tokens[i + 1] in _DETERMINERS else t
+            for i, t in enumerate(tokens)]
 
 
 _MARKER_WORDS = tuple(tuple(m.split()) for m in MARKERS)
@@ -196,21 +209,26 @@ def _is_number_token(token: str) -> bool:
 def _parse_integer_words(tokens: Sequence[str], i: int) -> tuple[float, int] | None:
     """`twenty five`, `one hundred and twenty`, `three sixty`, `seven`: value and next index."""
     value = 0
-    last = ""  # the kind of the previous word: ones, tens, hundred, and
+    last = ""  # the kind of the previous word: ones, tens, hundred, thousand, and
     j = i
     while j < len(tokens):
         word = tokens[j]
-        if word in _ONES and word != "oh" and (
-                last in ("", "hundred", "and") or (last == "tens" and _ONES[word] < 10)):
+        if word in ("a", "an") and j == i and tokens[j + 1:j + 2] in (["hundred"], ["thousand"]):
+            # "a hundred and eighty degrees" is one number; read from "hundred" on, it would be eighty.
+            value, last = 1, "ones"
+        elif word in _ONES and word != "oh" and (
+                last in ("", "hundred", "thousand", "and") or (last == "tens" and _ONES[word] < 10)):
             value, last = value + _ONES[word], "ones"
-        elif word in _TENS and last in ("", "hundred", "and"):
+        elif word in _TENS and last in ("", "hundred", "thousand", "and"):
             value, last = value + _TENS[word], "tens"
         elif word in _TENS and last == "ones" and j == i + 1 and value < 10:
             # Hundreds said as two numbers, as people say angles: "one eighty", "three sixty".
             value, last = value * 100 + _TENS[word], "tens"
-        elif word == "hundred" and last in ("ones", "tens") and value < 100:
-            value, last = value * 100, "hundred"
-        elif (word == "and" and last == "hundred" and j + 1 < len(tokens)
+        elif word == "hundred" and last in ("ones", "tens") and value % 1000 < 100:
+            value, last = value - value % 1000 + value % 1000 * 100, "hundred"
+        elif word == "thousand" and last in ("ones", "tens", "hundred") and value < 1000:
+            value, last = value * 1000, "thousand"
+        elif (word == "and" and last in ("hundred", "thousand") and j + 1 < len(tokens)
               and (tokens[j + 1] in _ONES or tokens[j + 1] in _TENS)):
             last = "and"
         else:
@@ -310,9 +328,17 @@ def _smaller_length_after(tokens: Sequence[str], end: int, factor: float, total:
     if parsed is None or parsed[0] <= 0:
         return total, end
     value, j = parsed
-    if j >= len(tokens) or _LENGTHS.get(tokens[j], factor) >= factor:
+    if j < len(tokens) and tokens[j] in _LENGTHS:
+        if _LENGTHS[tokens[j]] >= factor:
+            return total, end
+        return total + value * _LENGTHS[tokens[j]], j + 1
+    # "a metre fifty", "two foot six": the smaller unit goes unsaid, as people say heights.
+    implied = _UNSAID_SMALLER.get(factor)
+    if (implied is None or start != end or value != int(value) or value * implied >= factor
+            or _unit_at(tokens, j) is not None or tokens[j:j + 1] in (["times"], ["more"], ["of"])
+            or _coordinates_at(tokens, start) is not None):
         return total, end
-    return total + value * _LENGTHS[tokens[j]], j + 1
+    return total + value * implied, j
 
 
 def _convert_numbers(tokens: list[str]) -> list[str]:

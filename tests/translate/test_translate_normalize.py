@@ -108,6 +108,33 @@ def test_normalize_keeps_words_that_only_sound_like_numbers(task: str) -> None:
     assert normalize_task(task) == task
 
 
+@pytest.mark.parametrize(
+    ("task", "expected"),
+    [("turn a hundred and eighty degrees", "turn 3.1416 rad"), ("turn a hundred eighty degrees", "turn 3.1416 rad"),
+     ("go a hundred and fifty centimetres", "go 1.5 m"), ("go one thousand millimetres", "go 1 m"),
+     ("go a thousand two hundred and fifty millimetres", "go 1.25 m"),
+     ("go forward nought point five metres", "go forward 0.5 m")],
+)
+def test_normalize_reads_a_hundred_and_thousands_as_one_number(task: str, expected: str) -> None:
+    assert normalize_task(task) == expected
+
+
+@pytest.mark.parametrize(
+    ("task", "expected"),
+    [("go forward a metre fifty", "go forward 1.5 m"), ("move forward two foot six", "move forward 0.762 m"),
+     ("go forward one metre twenty then turn left", "go forward 1.2 m then turn left"),
+     ("go forward a metre 5 times", "go forward 1 m 5 times"), ("go forward two feet 14", "go forward 0.6096 m 14")],
+)
+def test_normalize_reads_a_smaller_unit_left_unsaid(task: str, expected: str) -> None:
+    assert normalize_task(task) == expected
+
+
+@pytest.mark.parametrize(("task", "expected"), [("go too the fridge", "go to the fridge"),
+                                                ("go two the kitchen", "go to the kitchen")])
+def test_normalize_hears_to_where_a_number_cannot_be(task: str, expected: str) -> None:
+    assert normalize_task(task) == expected
+
+
 def test_normalize_is_idempotent_on_its_own_output() -> None:
     for task in ["move forward 2 m, then grasp the cup", "turn left 1.5708 rad", "go to -3.5, 2"]:
         assert normalize_task(normalize_task(task)) == normalize_task(task)
