@@ -92,6 +92,7 @@ def normalize_task(text: str) -> str:
     tokens = _tokenize(text)
     tokens = _drop_fillers(tokens)
     tokens = _hear_to(tokens)
+    tokens = _join_split_numbers(tokens)
     tokens = _carry_corrected_units(tokens)
     tokens = _carry_correcting_units(tokens)
     tokens = _convert_numbers(tokens)
@@ -132,6 +133,25 @@ _DETERMINERS = frozenset({"the", "your", "my", "its", "his", "her", "their", "ou
 def _hear_to(tokens: list[str]) -> list[str]:
     return ["to" if t in _TO_HEARD_AS and tokens[i + 1:i + 2] and tokens[i + 1] in _DETERMINERS else t
             for i, t in enumerate(tokens)]
+
+
+# A recognizer that splits a number word in two ("for ty five", "six teen"): the halves are no words.
+_NUMBER_ENDINGS = ("ty", "teen")
+_FOUR_HEARD_AS = frozenset({"for", "fore", "four"})
+
+
+def _join_split_numbers(tokens: list[str]) -> list[str]:
+    out: list[str] = []
+    for token in tokens:
+        if token in _NUMBER_ENDINGS and out:
+            joined = out[-1] + token
+            if out[-1] in _FOUR_HEARD_AS:
+                joined = "forty" if token == "ty" else "fourteen"
+            if joined in _TENS or joined in _ONES:
+                out[-1] = joined
+                continue
+        out.append(token)
+    return out
 
 
 _MARKER_WORDS = tuple(tuple(m.split()) for m in MARKERS)

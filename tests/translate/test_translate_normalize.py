@@ -135,6 +135,16 @@ def test_normalize_hears_to_where_a_number_cannot_be(task: str, expected: str) -
     assert normalize_task(task) == expected
 
 
+@pytest.mark.parametrize(
+    ("task", "expected"),
+    [("turn left for ty five degrees", "turn left 0.7854 rad"), ("go six ty centimetres", "go 0.6 m"),
+     ("turn fif teen degrees", "turn 0.2618 rad"), ("go for teen centimetres", "go 0.14 m"),
+     ("i have ty", "i have ty")],
+)
+def test_normalize_joins_a_number_word_heard_in_two(task: str, expected: str) -> None:
+    assert normalize_task(task) == expected
+
+
 def test_normalize_is_idempotent_on_its_own_output() -> None:
     for task in ["move forward 2 m, then grasp the cup", "turn left 1.5708 rad", "go to -3.5, 2"]:
         assert normalize_task(normalize_task(task)) == normalize_task(task)
