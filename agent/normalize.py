@@ -93,6 +93,7 @@ def normalize_task(text: str) -> str:
     tokens = _drop_fillers(tokens)
     tokens = _hear_to(tokens)
     tokens = _join_split_numbers(tokens)
+    tokens = _join_split_words(tokens)
     tokens = _carry_corrected_units(tokens)
     tokens = _carry_correcting_units(tokens)
     tokens = _convert_numbers(tokens)
@@ -151,6 +152,34 @@ def _join_split_numbers(tokens: list[str]) -> list[str]:
                 out[-1] = joined
                 continue
         out.append(token)
+    return out
+
+
+# Words a recognizer splits in two ("turn a round", "go for ward"). "a round" is also an article and an
+# adjective ("grab a round box"), so it is joined only where no noun follows; "a head" is the robot's head
+# misheard ("pan a head left"), never joined.
+_SPLIT_WORDS = {("for", "ward"): "forward", ("fore", "ward"): "forward", ("back", "ward"): "backward",
+                ("back", "wards"): "backwards", ("to", "wards"): "towards"}
+_SPLIT_BEFORE_NO_NOUN = {("a", "round"): "around"}
+_NO_NOUN = frozenset({",", "to", "and", "then", "the", "your", "please", "again", "once", "twice", "left", "right",
+                      "now"})
+
+
+def _join_split_words(tokens: list[str]) -> list[str]:
+    out: list[str] = []
+    i = 0
+    while i < len(tokens):
+        pair = (tokens[i], tokens[i + 1] if i + 1 < len(tokens) else "")
+        after = tokens[i + 2] if i + 2 < len(tokens) else ","
+        joined = _SPLIT_WORDS.get(pair)
+        if joined is None and (after in _NO_NOUN or _parse_number(tokens, i + 2) is not None):
+            joined = _SPLIT_BEFORE_NO_NOUN.get(pair)
+        if joined is not None:
+            out.append(joined)
+            i += 2
+        else:
+            out.append(tokens[i])
+            i += 1
     return out
 
 

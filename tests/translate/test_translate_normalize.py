@@ -145,6 +145,16 @@ def test_normalize_joins_a_number_word_heard_in_two(task: str, expected: str) ->
     assert normalize_task(task) == expected
 
 
+@pytest.mark.parametrize(
+    ("task", "expected"),
+    [("uh turn a round", "turn around"), ("turn a round to the right", "turn around to the right"),
+     ("go for ward to meters", "go forward 2 m"), ("move back wards a little", "move backwards a little"),
+     ("grab a round box", "grab a round box"), ("pan a head left", "pan a head left")],
+)
+def test_normalize_joins_a_word_heard_in_two(task: str, expected: str) -> None:
+    assert normalize_task(task) == expected
+
+
 def test_normalize_is_idempotent_on_its_own_output() -> None:
     for task in ["move forward 2 m, then grasp the cup", "turn left 1.5708 rad", "go to -3.5, 2"]:
         assert normalize_task(normalize_task(task)) == normalize_task(task)
