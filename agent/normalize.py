@@ -274,7 +274,9 @@ def _parse_integer_words(tokens: Sequence[str], i: int) -> tuple[float, int] | N
             # Hundreds said as two numbers, as people say angles: "one eighty", "three sixty".
             value, last = value * 100 + _TENS[word], "tens"
         elif word == "hundred" and last in ("ones", "tens") and value % 1000 < 100:
-            value, last = value - value % 1000 + value % 1000 * 100, "hundred"
+            # Only what was said after the thousands counts hundreds: "a thousand two hundred".
+            thousands = value - value % 1000
+            value, last = thousands + value % 1000 * 100, "hundred"
         elif word == "thousand" and last in ("ones", "tens", "hundred") and value < 1000:
             value, last = value * 1000, "thousand"
         elif (word == "and" and last in ("hundred", "thousand") and j + 1 < len(tokens)
