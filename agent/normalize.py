@@ -3,7 +3,8 @@
 A 270M model copies numbers well but cannot do arithmetic, so everything the
 model would otherwise have to compute is done here: number words become
 digits, units become the profile's units (metres and radians), ASR homophones
-in numeric context become digits, and fillers go. Object words are kept.
+in numeric context become digits, words a recognizer split in two ("for ty",
+"a round") are joined, and fillers go. Object words are kept.
 
 The output format is a contract with the adapter's training data, which is
 normalized by this same function: lowercase words separated by single
