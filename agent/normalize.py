@@ -156,11 +156,10 @@ def _join_split_numbers(tokens: list[str]) -> list[str]:
     return out
 
 
-# Words a recognizer splits in two ("turn a round", "go for ward"). "a round" is also an article and an
+# Words a recognizer splits in two ("turn a round", "to wards"). "a round" is also an article and an
 # adjective ("grab a round box"), so it is joined only where no noun follows; "a head" is the robot's head
-# misheard ("pan a head left"), never joined.
-_SPLIT_WORDS = {("for", "ward"): "forward", ("fore", "ward"): "forward", ("back", "ward"): "backward",
-                ("back", "wards"): "backwards", ("to", "wards"): "towards"}
+# misheard ("pan a head left"), never joined. A skill's own words are the profile's to name, not this table's.
+_SPLIT_WORDS = {("to", "wards"): "towards"}
 _SPLIT_BEFORE_NO_NOUN = {("a", "round"): "around"}
 _NO_NOUN = frozenset({",", "to", "and", "then", "the", "your", "please", "again", "once", "twice", "left", "right",
                       "now"})

@@ -148,7 +148,7 @@ def test_normalize_joins_a_number_word_heard_in_two(task: str, expected: str) ->
 @pytest.mark.parametrize(
     ("task", "expected"),
     [("uh turn a round", "turn around"), ("turn a round to the right", "turn around to the right"),
-     ("go for ward to meters", "go forward 2 m"), ("move back wards a little", "move backwards a little"),
+     ("walk to wards the door", "walk towards the door"),
      ("grab a round box", "grab a round box"), ("pan a head left", "pan a head left")],
 )
 def test_normalize_joins_a_word_heard_in_two(task: str, expected: str) -> None:
