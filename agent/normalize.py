@@ -172,8 +172,8 @@ def _join_split_words(tokens: list[str]) -> list[str]:
         pair = (tokens[i], tokens[i + 1] if i + 1 < len(tokens) else "")
         after = tokens[i + 2] if i + 2 < len(tokens) else ","
         joined = _SPLIT_WORDS.get(pair)
-        if joined is None and (after in _NO_NOUN or _parse_number(tokens, i + 2) is not None):
-            joined = _SPLIT_BEFORE_NO_NOUN.get(pair)
+        if pair in _SPLIT_BEFORE_NO_NOUN and (after in _NO_NOUN or _parse_number(tokens, i + 2) is not None):
+            joined = _SPLIT_BEFORE_NO_NOUN[pair]
         if joined is not None:
             out.append(joined)
             i += 2
