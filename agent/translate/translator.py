@@ -264,7 +264,15 @@ class Translator:
         plan = result.plan if verified else None
         program = attempts[-1].program
         judged = {}
-        if plan is not None:
+        read_again = self._no_task_read_in_clauses(states, normalized, known, cancel, timings)
+        if read_again is not None:
+            program, plan, _probabilities, assessment = read_again
+            attempts.append(Attempt(program=program, diagnostics=()))
+            verified = True
+            if back is not None:
+                program, plan = self._putting_back(program, plan, back, known)
+            judged = result_fields(plan, self.profile, assessment)
+        elif plan is not None:
             checks_started = time.perf_counter()
             model = model_signal(p for s in states for p in s.probabilities)
             assessment = assess(normalized, plan, self.profile, model=model, known_objects=known)
@@ -392,6 +400,29 @@ class Translator:
             return passing
         return None
 
+    def _no_task_read_in_clauses(self, states: list[_ClauseState], normalized: str, known: Collection[str] | None,
+                                 cancel: CancelFlag | None, timings: dict[str, float]) -> _Candidate | None:
+        """The plan from reading a clause at a time a task the model read whole as no task; None when it
+        did not refuse it, or when no clause gives a plan that passes the checks.
+
+        A remark before the request ("the cat is hiding under the bed again, could you look down a
+        little?") makes the whole read as talk, and the request is lost. Read alone, the remark still
+        gives no step and the request gives its own. The checks read the whole task, and the readings
+        disagreed, so the plan is always put to the person: words that were no request at all are asked
+        about, never run.
+        """
+        if len(states) != 1 or not (states[0].refused or states[0].unclear is not None):
+            return None
+        found = self._read_in_clauses(normalized, known, cancel, timings)
+        if found is None:
+            return None
+        program, plan, probabilities, assessment = found
+        progress.debug("read whole it was no task; read a clause at a time it gives %r, which passes the checks",
+                       program.strip())
+        disagreement = Doubt("whole", "read whole, the words did not read as a task for the robot; this plan "
+                                      "reads them a step at a time")
+        return program, plan, probabilities, with_doubt(assessment, disagreement)
+
     def _clause_by_clause(self, normalized: str, whole: Plan, judged: Assessment, known: Collection[str] | None,
                           cancel: CancelFlag | None, timings: dict[str, float]) -> _Candidate | None:
         """The program from reading the task a clause at a time, where the whole task's program fails a
@@ -405,6 +436,21 @@ class Translator:
         whole task. A clause that reads as no task ("keep your head still") gives no step. The readings
         disagreed, so the plan it gives is always put to the person.
         """
+        passing = self._read_in_clauses(normalized, known, cancel, timings)
+        if passing is None:
+            return None
+        program, plan, probabilities, assessment = passing
+        progress.debug("the checks found fault with the whole program; read a clause at a time it gives %r, "
+                       "which passes them", program.strip())
+        disagreement = Doubt("whole", f"read whole, the task gave another plan ({explain(whole, self.profile)}), "
+                                      f"and {judged.doubts[0].reason}; this one reads it a step at a time")
+        return program, plan, probabilities, with_doubt(assessment, disagreement)
+
+    def _read_in_clauses(self, normalized: str, known: Collection[str] | None, cancel: CancelFlag | None,
+                         timings: dict[str, float]) -> _Candidate | None:
+        """The plan from reading the task a clause at a time, when it has two clauses or more, some clause
+        reads as a task and the plan passes every check; the generations' time is added to `timings`.
+        A clause that reads as no task ("keep your head still") gives no step."""
         if self.options.split_clauses:
             return None
         states = [_ClauseState(c) for c in split_clauses(normalized, self.profile)]
@@ -423,15 +469,9 @@ class Translator:
                 # "keep your head still" asks for no step of its own; the checks still read it in the task.
                 state.program, state.probabilities = "", ()
         probabilities = tuple(p for s in states for p in s.probabilities)
-        passing = self._passing(_assemble(states), probabilities, normalized, known)
-        if passing is None:
-            return None
-        program, plan, probabilities, assessment = passing
-        progress.debug("the checks found fault with the whole program; read a clause at a time (%s) it gives "
-                       "%r, which passes them", " | ".join(repr(s.clause.text) for s in states), program.strip())
-        disagreement = Doubt("whole", f"read whole, the task gave another plan ({explain(whole, self.profile)}), "
-                                      f"and {judged.doubts[0].reason}; this one reads it a step at a time")
-        return program, plan, probabilities, with_doubt(assessment, disagreement)
+        progress.debug("read a clause at a time: %s", " | ".join(f"{s.clause.text!r} -> {s.program.strip()!r}"
+                                                                 for s in states))
+        return self._passing(_assemble(states), probabilities, normalized, known)
 
     def _generate(self, prompt: str, automaton: RslAutomaton | None, cancel: CancelFlag | None,
                   timings: dict[str, float], fork: Fork | None = None) -> Generation:

@@ -258,3 +258,41 @@ def test_a_clause_that_reads_as_no_task_gives_no_step_of_the_clause_by_clause_re
     assert found is not None
     program, _plan, _probabilities, assessment = found
     assert program == "turnright 0.7854;\n" and assessment.unsure
+
+
+def _refused_whole(task: str) -> tuple[str, _ClauseState]:
+    """The normalized task with a whole reading in which the model wrote that it has no program."""
+    normalized = normalize_task(task)
+    state = _ClauseState(Clause(text=normalized))
+    state.program, state.refused = "// no program\n", True
+    return normalized, state
+
+
+def test_a_request_after_a_remark_read_whole_as_no_task_is_read_a_clause_at_a_time_and_questioned(
+        adapted: Translator) -> None:
+    # Read whole, the shipped adapter takes the remark for talk and writes no program; before, the request
+    # was refused with it.
+    result = adapted.translate("The cat is hiding under the bed again. Could you look down a little?")
+    assert result.verified and not result.refused and result.program == "lookdown 0.2618;\n"
+    assert result.confirm and "whole" in result.doubted_by
+    assert any("did not read as a task" in d and "a step at a time" in d for d in result.doubts)
+    # The whole reading's refusal stays in the record of what was tried.
+    assert len(result.attempts) == 2 and not result.attempts[0].ok
+
+
+def test_a_clause_reading_of_words_read_whole_as_no_task_must_pass_the_checks(adapted: Translator) -> None:
+    # Read alone, "drive forward 2 m" drives; the checks read the whole, where "see" asks about the head.
+    normalized, state = _refused_whole("I can see you on my screen from the office. Drive forward two meters.")
+    timings = {"prompt": 0.0, "generate": 0.0}
+    assert adapted._no_task_read_in_clauses([state], normalized, None, None, timings) is None
+    assert timings["generate"] > 0
+
+
+def test_a_whole_reading_that_gave_a_program_or_had_one_clause_is_not_read_again(adapted: Translator) -> None:
+    timings = {"prompt": 0.0, "generate": 0.0}
+    normalized, state = _refused_whole("the cat is hiding under the bed again, look down a little")
+    state.refused = False
+    assert adapted._no_task_read_in_clauses([state], normalized, None, None, timings) is None
+    normalized, state = _refused_whole("thanks, that's all for today")
+    assert adapted._no_task_read_in_clauses([state], normalized, None, None, timings) is None
+    assert timings["prompt"] + timings["generate"] == 0.0
