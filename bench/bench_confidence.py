@@ -39,10 +39,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from agent.evalsuite import load_suite
 from agent.evalsuite.runner import percentile
 from agent.evalsuite.suite import accepts, suite_path
-from agent.normalize import normalize_task
 from agent.translate import Translator
 from agent.translate.confidence import UNSURE_BELOW, assess, result_fields
 from agent.translate.engine import Generation
+from agent.translate.misheard import heard
 from agent.translate.translator import GUESSING_BELOW, task_reading
 from bench import SPLIT
 from rsl.profile import load_profile
@@ -126,7 +126,7 @@ def main() -> int:
         if result.plan is not None:
             # The checks, explanation and confidence again, timed alone and side by side with the translation.
             begin = time.perf_counter()
-            assessment = assess(normalize_task(task.task), result.plan, profile, known_objects=task.objects)
+            assessment = assess(heard(task.task), result.plan, profile, known_objects=task.objects)
             result_fields(result.plan, profile, assessment)
             checks_ms.append((time.perf_counter() - begin) * 1000)
             # The translator's own: a plan read again a clause at a time carries a doubt no check of it has.

@@ -20,13 +20,13 @@ from pathlib import Path
 from typing import Any, Protocol
 
 from agent.adapter.card import AdapterCard, card_path, read_card
-from agent.normalize import normalize_task
 from agent.translate.automaton import RslAutomaton
 from agent.translate.clauses import Clause, split_clauses
 from agent.translate.confidence import Assessment, assess, model_signal, result_fields, with_doubt
 from agent.translate.engine import FORK_RECORD_FLOOR, CancelFlag, Fork, Generation
 from agent.translate.explain import explain
 from agent.translate.meaning import Doubt
+from agent.translate.misheard import heard
 from agent.translate.model_path import ModelNotFoundError
 from agent.translate.names import DETERMINERS, FUNCTION_WORDS, NOT_NAMES, offered_names
 from agent.translate.part_back import PutBack, put_back, undoing
@@ -198,7 +198,7 @@ class Translator:
                    on_attempt: Callable[[Attempt], None] | None, cancel: CancelFlag | None) -> TranslationResult:
         started = time.perf_counter()
         timings = {"prompt": 0.0, "generate": 0.0, "compile": 0.0}
-        normalized = normalize_task(task)
+        normalized = heard(task)
         if not normalized:
             return TranslationResult(task=task, program="", verified=False, passes=0, attempts=(), plan=None,
                                      model=self.model_name, timings_ms={**timings, "total": 0.0})

@@ -1,0 +1,52 @@
+"""Words a recognizer writes for a direction, read back before the model and the checks read a task.
+
+A recognizer hears "right" as "write" or "rite". The model reads "turn
+write" as a right turn, but unsurely, and "turn around to the write" as a
+left one. Where the verb cannot be meant (after an article, before an
+amount, at the end of a clause), the word is read as "right".
+
+This runs at run time only, after `normalize_task`, and not on the
+adapter's training data: the data keeps the mishearing, so the model still
+learns to read the ones this leaves ("write" after "you", where it may be
+the verb) and a retrain is not needed for it.
+"""
+
+from __future__ import annotations
+
+from agent.normalize import normalize_task
+
+_HEARD_FOR_RIGHT = frozenset({"write", "rite"})
+# What cannot come right before the verb "write": an article, a possessive, or a word for how sharply to turn.
+_BEFORE_NO_VERB = frozenset({"the", "a", "an", "your", "my", "hard", "sharp"})
+# What may come right before the verb "write" ("you write", "please write"): then it is left alone. The
+# normalizer has already dropped a leading "can you", so a first word is read back only before an amount.
+_BEFORE_VERB = frozenset({"", "i", "you", "we", "they", "he", "she", "it", "can", "could", "will", "would",
+                          "should", "must", "to", "please", "and", "then"})
+# What cannot follow the verb "write": the end of a clause.
+_CLAUSE_WORDS = frozenset({"", ",", "and", "then", "please", "now", "again", "instead", "side", "turn"})
+# Amounts said in words that the normalizer leaves as words ("turn write a little").
+_WORD_AMOUNTS = (("a", "little"), ("a", "bit"), ("slightly",))
+
+
+def heard(task: str) -> str:
+    """The task as the model and the checks read it: normalized, with mishearings read back."""
+    # The normalizer writes a clause comma right after its word ("turn write, then").
+    words = normalize_task(task).replace(",", " ,").split()
+    out = []
+    for i, word in enumerate(words):
+        misheard = word in _HEARD_FOR_RIGHT and _not_the_verb(words[i - 1] if i else "", words[i + 1:i + 3])
+        out.append("right" if misheard else word)
+    return " ".join(out).replace(" ,", ",")
+
+
+def _not_the_verb(before: str, after: list[str]) -> bool:
+    if before in _BEFORE_NO_VERB:
+        return True
+    amount = bool(after) and (_is_number(after[0]) or any(tuple(after[:len(w)]) == w for w in _WORD_AMOUNTS))
+    if before in _BEFORE_VERB:
+        return amount and not before
+    return amount or (after[0] if after else "") in _CLAUSE_WORDS
+
+
+def _is_number(word: str) -> bool:
+    return word.replace(".", "", 1).isdigit()

@@ -1,0 +1,60 @@
+"""A recognizer's "write" for "right", read back where the verb cannot be meant, and only at run time."""
+
+from __future__ import annotations
+
+import random
+
+import pytest
+
+from agent.adapter.data import asr_noise
+from agent.normalize import normalize_task
+from agent.translate import Translator
+from agent.translate.misheard import heard
+
+
+@pytest.mark.parametrize(("said", "read"), [
+    ("turn write", "turn right"),
+    ("turn rite ninety degrees", "turn right 1.5708 rad"),
+    ("turn around to the write", "turn around to the right"),
+    ("hang a write, then go two metres", "hang a right, then go 2 m"),
+    ("make a write turn", "make a right turn"),
+    ("turn write a little", "turn right a little"),
+    ("write forty five degrees", "right 0.7854 rad"),
+])
+def test_write_where_the_verb_cannot_be_meant_is_right(said: str, read: str) -> None:
+    assert heard(said) == read
+
+
+@pytest.mark.parametrize("said", [
+    "write a note",
+    "can you write",
+    "could you write it down",
+    "i will write 5 lines",
+    "please write, then turn left",
+])
+def test_write_that_may_be_the_verb_is_left_alone(said: str) -> None:
+    assert heard(said) == normalize_task(said)
+
+
+def test_every_other_task_reads_as_normalized() -> None:
+    said = "Go to the point 1, -2, then turn left thirty degrees, and look around."
+    assert heard(said) == normalize_task(said)
+
+
+def test_the_adapter_s_data_keeps_the_mishearing() -> None:
+    # The model learns "write" for "right" from its data, so it still reads the ones left alone here.
+    noisy = {normalize_task(asr_noise("turn right", random.Random(seed))) for seed in range(200)}
+    assert any("write" in task.split() for task in noisy)
+
+
+def test_a_misheard_direction_is_read_as_surely_as_the_word(adapted: Translator) -> None:
+    misheard, said = adapted.translate("turn write"), adapted.translate("turn right")
+    assert misheard.program == said.program == "turnright 1.5708;\n"
+    assert not misheard.confirm and misheard.confidence == pytest.approx(said.confidence, abs=0.01)
+
+
+def test_a_misheard_direction_is_checked_against_the_plan(adapted: Translator) -> None:
+    # Unread, "write" was no direction, so a left turn around ran unasked.
+    result = adapted.translate("turn around to the write")
+    assert result.program.split() == ["turnright", "3.1416;"] or (
+        result.confirm and any("you said right" in doubt for doubt in result.doubts))
