@@ -15,7 +15,7 @@ CORRECTIONS = (", no, {b}", ", sorry, {b}", ", i mean {b}", ", no wait, {b}", ",
                ", actually {b}", ", oops, {b}", ", no sorry, {b}", " - no, {b}", ", or rather {b}")
 # What people also say to take something back, which the training data does not write: the runtime
 # reads them as it reads the templates' words.
-SPOKEN = ("scratch that", "i meant", "correction")
+SPOKEN = ("scratch that", "i meant", "correction", "make it")
 # The words of each template, longest first so that "no wait" is read before "no".
 MARKERS = tuple(sorted({re.sub(r"[^a-z ]", "", t.replace("{b}", "")).strip() for t in CORRECTIONS} | set(SPOKEN),
                        key=len, reverse=True))

@@ -194,8 +194,8 @@ def _carry_corrected_units(tokens: list[str]) -> list[str]:
     """
     out = list(tokens)
     for at in range(len(out) - 1, 0, -1):
-        unit = out[at - 1]
-        if unit not in _LENGTHS and unit not in _ANGLES:
+        unit = _unit_before(out, at)
+        if unit is None:
             continue
         # Commas may be several: an ellipsis ("30 degrees... no, 60") is read as commas, and so is a
         # filler's ("30 degrees, uh, no, 60") once the filler is dropped.
@@ -208,6 +208,22 @@ def _carry_corrected_units(tokens: list[str]) -> list[str]:
             continue
         out.insert(end, unit)
     return out
+
+
+# Words that may come between an amount and the marker that corrects it: the way it goes ("45 degrees to the
+# left, make that 60").
+_WAY_WORDS = _TURN_WAYS | {"to", "the", "your", "my"}
+_WAY_WORDS_BETWEEN = 3
+
+
+def _unit_before(tokens: Sequence[str], at: int) -> str | None:
+    """The unit of the amount said last before tokens[at], with at most a few words of its way between."""
+    for k in range(at - 1, max(-1, at - 2 - _WAY_WORDS_BETWEEN), -1):
+        if tokens[k] in _LENGTHS or tokens[k] in _ANGLES:
+            return tokens[k]
+        if tokens[k] not in _WAY_WORDS:
+            return None
+    return None
 
 
 def _carry_correcting_units(tokens: list[str]) -> list[str]:

@@ -76,6 +76,10 @@ from agent.normalize import normalize_task
         ("drive 2 meters, no, 3 feet", "drive 2 m, no, 0.9144 m"),
         # ... after a run of markers too.
         ("turn right ninety degrees, no, make that forty-five", "turn right 1.5708 rad, no, make that 0.7854 rad"),
+        # ... with the way it goes said between, and after "make it".
+        ("Forty-five degrees to the left. Make that sixty.", "0.7854 rad to the left, make that 1.0472 rad"),
+        ("Forward 50 centimetres, no wait, make it 30.", "forward 0.5 m, no wait, make it 0.3 m"),
+        ("turn left 90 degrees and go forward, no, 2", "turn left 1.5708 rad and go forward, no, 2"),
         # A bare number corrected by an amount takes the amount's unit; a bare number that is not, stays bare.
         ("go forward three, sorry, four metres", "go forward 3 m, sorry, 4 m"),
         ("turn left twenty five, sorry, thirty degrees", "turn left 0.4363 rad, sorry, 0.5236 rad"),
