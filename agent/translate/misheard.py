@@ -1,9 +1,11 @@
-"""Words a recognizer writes for a direction, read back before the model and the checks read a task.
+"""Words a recognizer writes for a direction or a colour, read back before the model and the checks read a task.
 
 A recognizer hears "right" as "write" or "rite". The model reads "turn
 write" as a right turn, but unsurely, and "turn around to the write" as a
 left one. Where the verb cannot be meant (after an article, before an
-amount, at the end of a clause), the word is read as "right".
+amount, at the end of a clause), the word is read as "right". It hears
+"red" as "read" and "blue" as "blew": between a determiner and the thing's
+noun ("the read ball") only the colour can be meant.
 
 This runs at run time only, after `normalize_task`, and not on the
 adapter's training data: the data keeps the mishearing, so the model still
@@ -26,6 +28,8 @@ _BEFORE_VERB = frozenset({"", "i", "you", "we", "they", "he", "she", "it", "can"
 _CLAUSE_WORDS = frozenset({"", ",", "and", "then", "please", "now", "again", "instead", "side", "turn"})
 # Amounts said in words that the normalizer leaves as words ("turn write a little").
 _WORD_AMOUNTS = (("a", "little"), ("a", "bit"), ("slightly",))
+_HEARD_FOR_COLOUR = {"read": "red", "blew": "blue"}
+_DETERMINERS = frozenset({"the", "a", "an", "your", "my", "that", "this"})
 
 
 def heard(task: str) -> str:
@@ -34,8 +38,13 @@ def heard(task: str) -> str:
     words = normalize_task(task).replace(",", " ,").split()
     out = []
     for i, word in enumerate(words):
-        misheard = word in _HEARD_FOR_RIGHT and _not_the_verb(words[i - 1] if i else "", words[i + 1:i + 3])
-        out.append("right" if misheard else word)
+        before, after = words[i - 1] if i else "", words[i + 1:i + 3]
+        if word in _HEARD_FOR_RIGHT and _not_the_verb(before, after):
+            word = "right"
+        elif (word in _HEARD_FOR_COLOUR and before in _DETERMINERS and after and after[0].isalpha()
+              and after[0] not in _CLAUSE_WORDS):
+            word = _HEARD_FOR_COLOUR[word]
+        out.append(word)
     return " ".join(out).replace(" ,", ",")
 
 

@@ -36,6 +36,19 @@ def test_write_that_may_be_the_verb_is_left_alone(said: str) -> None:
     assert heard(said) == normalize_task(said)
 
 
+@pytest.mark.parametrize(("said", "read"), [
+    ("drive up to the read ball", "drive up to the red ball"),
+    ("grab the blew cup, then turn left", "grab the blue cup, then turn left"),
+])
+def test_a_colour_heard_between_a_determiner_and_a_noun_is_the_colour(said: str, read: str) -> None:
+    assert heard(said) == read
+
+
+@pytest.mark.parametrize("said", ["read the label", "i read the book", "the wind blew the paper"])
+def test_read_and_blew_elsewhere_are_left_alone(said: str) -> None:
+    assert heard(said) == normalize_task(said)
+
+
 def test_every_other_task_reads_as_normalized() -> None:
     said = "Go to the point 1, -2, then turn left thirty degrees, and look around."
     assert heard(said) == normalize_task(said)
@@ -58,3 +71,8 @@ def test_a_misheard_direction_is_checked_against_the_plan(adapted: Translator) -
     result = adapted.translate("turn around to the write")
     assert result.program.split() == ["turnright", "3.1416;"] or (
         result.confirm and any("you said right" in doubt for doubt in result.doubts))
+
+
+def test_a_misheard_colour_names_the_thing(adapted: Translator) -> None:
+    # Unread, "the read ball" was sent to an object named read_ball, unasked.
+    assert adapted.translate("drive up to the read ball").program == "approach red_ball;\n"
