@@ -8,9 +8,9 @@ amount, at the end of a clause), the word is read as "right". It hears
 noun ("the read ball") only the colour can be meant.
 
 This runs at run time only, after `normalize_task`, and not on the
-adapter's training data: the data keeps the mishearing, so the model still
-learns to read the ones this leaves ("write" after "you", where it may be
-the verb) and a retrain is not needed for it.
+adapter's training data, so a retrain is not needed for it: the data keeps
+its "write" for "right", and the model still learns to read the ones this
+leaves ("write" after "you", where it may be the verb).
 """
 
 from __future__ import annotations
