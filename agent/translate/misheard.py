@@ -24,7 +24,7 @@ _BEFORE_NO_VERB = frozenset({"the", "a", "an", "your", "my", "hard", "sharp"})
 # normalizer has already dropped a leading "can you", so a first word is read back only before an amount.
 _BEFORE_VERB = frozenset({"", "i", "you", "we", "they", "he", "she", "it", "can", "could", "will", "would",
                           "should", "must", "to", "please", "and", "then"})
-# What cannot follow the verb "write": the end of a clause.
+# What cannot follow the verb "write": the end of a clause, or what a way is said of ("write side", "write turn").
 _CLAUSE_WORDS = frozenset({"", ",", "and", "then", "please", "now", "again", "instead", "side", "turn"})
 # Amounts said in words that the normalizer leaves as words ("turn write a little").
 _WORD_AMOUNTS = (("a", "little"), ("a", "bit"), ("slightly",))
