@@ -126,7 +126,7 @@ def main() -> int:
         if result.plan is not None:
             # The checks, explanation and confidence again, timed alone and side by side with the translation.
             begin = time.perf_counter()
-            assessment = assess(heard(task.task), result.plan, profile, known_objects=task.objects)
+            assessment = assess(heard(task.task, profile), result.plan, profile, known_objects=task.objects)
             result_fields(result.plan, profile, assessment)
             checks_ms.append((time.perf_counter() - begin) * 1000)
             # The translator's own: a plan read again a clause at a time carries a doubt no check of it has.

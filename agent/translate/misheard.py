@@ -11,11 +11,17 @@ This runs at run time only, after `normalize_task`, and not on the
 adapter's training data, so a retrain is not needed for it: the data keeps
 its "write" for "right", and the model still learns to read the ones this
 leaves ("write" after "you", where it may be the verb).
+
+It also writes a word of the robot's in two ("drive for ward", "a lit
+tle"): two words are joined where together they are a word of the
+profile's skills or conventions and the second alone is none of its words.
 """
 
 from __future__ import annotations
 
 from agent.normalize import normalize_task
+from agent.translate.vocabulary import Vocabulary, vocabulary
+from rsl.profile import Profile
 
 _HEARD_FOR_RIGHT = frozenset({"write", "rite"})
 # What cannot come right before the verb "write": an article, a possessive, or a word for how sharply to turn.
@@ -32,10 +38,10 @@ _HEARD_FOR_COLOUR = {"read": "red", "blew": "blue"}
 _DETERMINERS = frozenset({"the", "a", "an", "your", "my", "that", "this"})
 
 
-def heard(task: str) -> str:
+def heard(task: str, profile: Profile) -> str:
     """The task as the model and the checks read it: normalized, with mishearings read back."""
     # The normalizer writes a clause comma right after its word ("turn write, then").
-    words = normalize_task(task).replace(",", " ,").split()
+    words = _joined(normalize_task(task).replace(",", " ,").split(), vocabulary(profile))
     out = []
     for i, word in enumerate(words):
         before, after = words[i - 1] if i else "", words[i + 1:i + 3]
@@ -46,6 +52,18 @@ def heard(task: str) -> str:
             word = _HEARD_FOR_COLOUR[word]
         out.append(word)
     return " ".join(out).replace(" ,", ",")
+
+
+def _joined(words: list[str], vocab: Vocabulary) -> list[str]:
+    # A second half the profile knows ("turn left", "a head") or a number keeps the two words apart.
+    robot_words = vocab.skill_words | {w for c in vocab.conventions for w in c.words}
+    out: list[str] = []
+    for word in words:
+        if out and out[-1] + word in robot_words and word not in vocab.known_words and not _is_number(word):
+            out[-1] += word
+        else:
+            out.append(word)
+    return out
 
 
 def _not_the_verb(before: str, after: list[str]) -> bool:

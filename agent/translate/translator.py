@@ -198,7 +198,7 @@ class Translator:
                    on_attempt: Callable[[Attempt], None] | None, cancel: CancelFlag | None) -> TranslationResult:
         started = time.perf_counter()
         timings = {"prompt": 0.0, "generate": 0.0, "compile": 0.0}
-        normalized = heard(task)
+        normalized = heard(task, self.profile)
         if not normalized:
             return TranslationResult(task=task, program="", verified=False, passes=0, attempts=(), plan=None,
                                      model=self.model_name, timings_ms={**timings, "total": 0.0})

@@ -10,6 +10,9 @@ from agent.adapter.data import asr_noise
 from agent.normalize import normalize_task
 from agent.translate import Translator
 from agent.translate.misheard import heard
+from rsl.profile import load_profile
+
+PROFILE = load_profile()
 
 
 @pytest.mark.parametrize(("said", "read"), [
@@ -22,7 +25,7 @@ from agent.translate.misheard import heard
     ("write forty five degrees", "right 0.7854 rad"),
 ])
 def test_write_where_the_verb_cannot_be_meant_is_right(said: str, read: str) -> None:
-    assert heard(said) == read
+    assert heard(said, PROFILE) == read
 
 
 @pytest.mark.parametrize("said", [
@@ -33,7 +36,7 @@ def test_write_where_the_verb_cannot_be_meant_is_right(said: str, read: str) -> 
     "please write, then turn left",
 ])
 def test_write_that_may_be_the_verb_is_left_alone(said: str) -> None:
-    assert heard(said) == normalize_task(said)
+    assert heard(said, PROFILE) == normalize_task(said)
 
 
 @pytest.mark.parametrize(("said", "read"), [
@@ -41,17 +44,32 @@ def test_write_that_may_be_the_verb_is_left_alone(said: str) -> None:
     ("grab the blew cup, then turn left", "grab the blue cup, then turn left"),
 ])
 def test_a_colour_heard_between_a_determiner_and_a_noun_is_the_colour(said: str, read: str) -> None:
-    assert heard(said) == read
+    assert heard(said, PROFILE) == read
 
 
 @pytest.mark.parametrize("said", ["read the label", "i read the book", "the wind blew the paper"])
 def test_read_and_blew_elsewhere_are_left_alone(said: str) -> None:
-    assert heard(said) == normalize_task(said)
+    assert heard(said, PROFILE) == normalize_task(said)
+
+
+@pytest.mark.parametrize(("said", "read"), [
+    ("er drive for ward three meters", "drive forward 3 m"),
+    ("go back wards one meter", "go backwards 1 m"),
+    ("uh look up a lit tle", "look up a little"),
+])
+def test_a_robot_word_split_in_two_is_joined(said: str, read: str) -> None:
+    assert heard(said, PROFILE) == read
+
+
+@pytest.mark.parametrize("said", ["turn left", "look up a little", "pan a head left", "go back 2 metres",
+                                  "look for words"])
+def test_words_that_are_words_on_their_own_stay_apart(said: str) -> None:
+    assert heard(said, PROFILE) == normalize_task(said)
 
 
 def test_every_other_task_reads_as_normalized() -> None:
     said = "Go to the point 1, -2, then turn left thirty degrees, and look around."
-    assert heard(said) == normalize_task(said)
+    assert heard(said, PROFILE) == normalize_task(said)
 
 
 def test_the_adapter_s_data_keeps_the_mishearing() -> None:
