@@ -56,6 +56,8 @@ _ASKED_DOING = re.compile(r"\b(mind|before|after) ([a-z]{3,}?)ing\b")
 # "take a look", "get a picture": the verb only carries the noun, so it asks nothing of the gripper.
 _LIGHT_VERB = re.compile(r"\b(?:take|get|grab)\s+(?=(?:a|another)\s+(?:(?:quick|little|good|close)\s+)?"
                          r"(?:look|peek|glance|picture|photo|snapshot|pic)\b)")
+# "take a left", "take a sharp right": the verb carries a way of the base, so it asks nothing of the gripper.
+_TAKE_A_WAY = re.compile(r"\btake\s+(?=(?:a|the)\s+(?:(?:sharp|hard|quick|slight)\s+)?([a-z]+)\b)")
 # A point said whole: two numbers joined by a comma ("the point 3, -2").
 _POINT = re.compile(r"(?<![\w.])(-?\d*\.?\d+), (-?\d*\.?\d+)(?![\w.])")
 # Two amounts in one unit with only a comma and a few words between: the second may correct the first
@@ -109,8 +111,11 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
                   ) -> tuple[Doubt, ...]:
     """Every disagreement between the normalized `task` and `plan`; empty when they agree."""
     vocab = vocabulary(profile)
-    text = _ASKED_DOING.sub(lambda m: f"{m.group(1)} to {_stem(m.group(2), vocab)}",
-                            _LIGHT_VERB.sub("", task.lower()))
+    base_ways = {w for skill, mine, _opposite, theirs in vocab.directions
+                 if vocab.parts.get(skill, WHOLE) == WHOLE for w in mine | theirs}
+    taken_ways = {WHOLE for m in _TAKE_A_WAY.finditer(task.lower()) if m.group(1) in base_ways}
+    carried = _TAKE_A_WAY.sub(lambda m: "" if m.group(1) in base_ways else m.group(0), task.lower())
+    text = _ASKED_DOING.sub(lambda m: f"{m.group(1)} to {_stem(m.group(2), vocab)}", _LIGHT_VERB.sub("", carried))
     # A bare "no" before a correction ("left, no, make that right") takes a word back, not the clause.
     negated = " ".join(m.group(0) for m in _NEGATION.finditer(text) if m.group(0).strip() not in MARKERS)
     affirmed = _NEGATION.sub(lambda m: m.group(0) if m.group(0).strip() in MARKERS else " ", text)
@@ -119,7 +124,7 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     named = _named(WORD.findall(text), vocab)
     doubts: list[Doubt] = []
     doubts += _parts(plan, vocab, words, set(WORD.findall(negated)), named, profile,
-                     _asked_by_unlisted_verbs(affirmed, vocab) | _points_asked(affirmed, plan, vocab),
+                     _asked_by_unlisted_verbs(affirmed, vocab) | _points_asked(affirmed, plan, vocab) | taken_ways,
                      _asked_by_command_verbs(affirmed, vocab))
     doubts += _directions(plan, vocab, words, named, profile)
     doubts += _numbers(text, plan, vocab, profile)

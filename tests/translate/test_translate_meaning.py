@@ -200,6 +200,8 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
      "you took back 90° for 45°, but the plan does both (turn left 90°, then turn right 45°)"),
     # A number is taken back by one in its own unit: a turn after "no" corrects no distance.
     ("drive two meters, no, turn left 90 degrees", "turnleft 1.5708;", "you said 2 m, but the plan never uses it"),
+    # "take a left" asks for a turn of the base, not the head.
+    ("take a left", "lookleft 0.5236;", "you asked about the base, but the plan moves the head (look left 30°)"),
 ])
 def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str, expected: str,
                                                          profile: Profile) -> None:
@@ -326,6 +328,9 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     ("drive forward 2 meters and then left, no, make that right", "forward 2; turnright 1.5708;"),
     # A word of sequence after the marker makes another step.
     ("turn left 90 degrees, no wait, and then turn right 45 degrees", "turnleft 1.5708; turnright 0.7854;"),
+    # "take a left" carries a way, as "take a look" carries a noun: it asks nothing of the gripper.
+    ("take a left", "turnleft 1.5708;"),
+    ("take a sharp right, then straight on for two metres", "turnright 1.5708; forward 2;"),
 ])
 def test_a_plan_that_does_what_was_said_has_no_doubt(task: str, program: str, profile: Profile) -> None:
     assert reasons(task, program, profile, ["cup", "table", "keys"]) == []
