@@ -655,6 +655,15 @@ def _vague_amount(named: list[ConventionReading], vocab: Vocabulary, unit: str) 
     return max((v for values in used for v in values.get(unit, ())), default=0.0)
 
 
+def _in_a_row(parts: list[str], text: str) -> bool:
+    """Whether `parts` are said one after another, with no clause break between them."""
+    for piece in re.split(r"[,;]|\.(?!\d)", text):
+        tokens = WORD.findall(piece)
+        if any(tokens[i:i + len(parts)] == parts for i in range(len(tokens))):
+            return True
+    return False
+
+
 # Words that say a thing again without its name.
 _REFERS_BACK = re.compile(r"\b(?:it|them|there)\b")
 # A negation word that also starts a self-correction ("no, the keys") corrects rather than denies.
@@ -695,6 +704,9 @@ def _objects(text: str, affirmed_text: str, plan: Plan, known: Collection[str] |
                                           "before a thing's name"))
         elif not (name_words & words):
             doubts.append(Doubt("object", f"the plan uses the {name.replace('_', ' ')}, which you did not mention"))
+        elif (acting := sorted(name_words & vocab.skill_words)) and not _in_a_row(name.lower().split("_"), text):
+            doubts.append(Doubt("object", f"the plan takes '{name}' for one thing's name, but you did not say "
+                                          f"it so, and '{acting[0]}' names a direction or an action"))
         elif not name_words <= affirmed and name_words <= denied:
             doubts.append(Doubt("negation", f"you said not the {name.replace('_', ' ')}, but the plan uses it"))
     for name in sorted(known or ()) if planned else ():

@@ -202,6 +202,11 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
     ("drive two meters, no, turn left 90 degrees", "turnleft 1.5708;", "you said 2 m, but the plan never uses it"),
     # "take a left" asks for a turn of the base, not the head.
     ("take a left", "lookleft 0.5236;", "you asked about the base, but the plan moves the head (look left 30°)"),
+    # A thing's name made of words said apart, one of them an action.
+    ("go over to the blue crate, look down a little, and have a look",
+     "approach crate_look; lookdown 0.2618; perceive;",
+     "the plan takes 'crate_look' for one thing's name, but you did not say it so, and 'look' names a direction "
+     "or an action"),
 ])
 def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str, expected: str,
                                                          profile: Profile) -> None:
@@ -334,6 +339,9 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     # A convention goes its own ways, whatever way another step goes.
     ("turn left 45 degrees and look around",
      "turnleft 0.7854; lookleft 1.5708; perceive; lookright 3.1416; perceive; lookleft 1.5708;"),
+    # A thing's name said whole may hold a word of a skill, and one said apart may not be one.
+    ("grab the left glove", "grasp left_glove;"),
+    ("pick up the bottle of water", "grasp water_bottle;"),
 ])
 def test_a_plan_that_does_what_was_said_has_no_doubt(task: str, program: str, profile: Profile) -> None:
     assert reasons(task, program, profile, ["cup", "table", "keys"]) == []
