@@ -269,15 +269,14 @@ def _directions(plan: Plan, vocab: Vocabulary, words: set[str], named: list[Conv
     """The plan goes the way that was said, and goes both ways only when both were said.
 
     A convention the task names may go both ways ("look around" pans left,
-    then right), whatever way another step was said to go ("turn left, then
-    look around").
+    then right).
     """
     allowed = {skill for c in named for skill in c.skills}
     doubts = []
     for skill, mine, opposite, theirs in vocab.directions:
         for said_words, unsaid_words, wrong in ((mine, theirs, opposite), (theirs, mine, skill)):
             if _said(words, said_words) and not _said(words, unsaid_words):
-                hit = next((c for c in plan if c.skill == wrong and c.skill not in allowed), None)
+                hit = next((c for c in plan if c.skill == wrong), None)
                 if hit is not None:
                     doubts.append(Doubt("direction", f"you said {min(said_words)}, but the plan goes the "
                                                      f"other way ({say(hit, profile)})"))
