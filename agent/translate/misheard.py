@@ -1,4 +1,4 @@
-"""Words a recognizer writes for a direction or a colour, read back before the model and the checks read a task.
+"""Words a recognizer writes for a direction or a colour, or splits in two, read back before a task is read.
 
 A recognizer hears "right" as "write" or "rite". The model reads "turn
 write" as a right turn, but unsurely, and "turn around to the write" as a
@@ -12,8 +12,8 @@ adapter's training data, so a retrain is not needed for it: the data keeps
 its "write" for "right", and the model still learns to read the ones this
 leaves ("write" after "you", where it may be the verb).
 
-It also writes a word of the robot's in two ("drive for ward", "a lit
-tle"): two words are joined where together they are a word of the
+A recognizer also writes a word of the robot's in two ("drive for ward",
+"a lit tle"): two words are joined where together they are a word of the
 profile's skills or conventions and the second alone is none of its words.
 """
 
