@@ -94,6 +94,14 @@ _QUESTION = re.compile(r"^(?:[a-z]+, )?(?:(?:why|what|where|when|who|which|how) 
                        r"(?:do|does|did|is|are|was|were|have|has|had|can|could|will|would|should)"
                        r"|(?:did|was|were|have|has|had) (?:you|it|we|they|i))\b(?!')"
                        r"(?!.*\bthen\b)[^,;.]*$")
+# An order told of, imagined or planned for later is not given now: "she told me to turn left",
+# "my dad always said, turn around", "you should have gone back", "if I asked you to fetch it",
+# "tomorrow we'll get it to fetch the mail". "Like I said, turn left" repeats an order, so "I" is left out.
+_FRAMED = re.compile(r"\b(?:told|tells?|asked|asks?|wants?|wanted) (?:me|us|him|her|them) to\b"
+                     r"|\b(?!i\b)[a-z]+ (?:(?:always|once|just|never|also) )?(?:said|says)\b"
+                     r"|\b(?:should|could|would|might|must)(?:n'?t)? (?:have|'ve)\b|\b(?:should|could)'ve\b"
+                     r"|\bif i (?:asked|told|wanted) you\b|\bwhat (?:would|will) happen if\b|\bwhat (?:happens )?if\b"
+                     r"|\b(?:later|tomorrow|tonight|next (?:week|time|month|year)|some ?day|one day|in the future)\b")
 _TOLERANCE = 0.02
 
 
@@ -141,6 +149,9 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     doubts += _one_object(named, plan)
     doubts += _negated_done([c for c in named if c not in affirmed_named], plan, vocab)
     doubts += _objects(text, affirmed, plan, known_objects, vocab)
+    if _FRAMED.search(text):
+        doubts.append(Doubt("framed", f"you told of an order, imagined one or planned one for later, but did not "
+                                      f"give it, and the plan acts ({say(plan.commands[0], profile)})"))
     if _QUESTION.match(text):
         doubts.append(Doubt("question", f"you asked a question, not for the robot to act, but the plan acts "
                                         f"({say(plan.commands[0], profile)})"))

@@ -138,6 +138,16 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
      "you asked a question, not for the robot to act, but the plan acts (drive forward 2 m)"),
     ("have you looked up at the shelf yet", "lookup 0.5236;",
      "you asked a question, not for the robot to act, but the plan acts (look up 30°)"),
+    # An order told of, imagined or planned for later is not given now.
+    ("my sister told me to turn left at the end of the road", "turnleft 1.5708;",
+     "you told of an order, imagined one or planned one for later, but did not give it, and the plan acts "
+     "(turn left 90°)"),
+    ("what would happen if you drove forward two metres", "forward 2;",
+     "you told of an order, imagined one or planned one for later, but did not give it, and the plan acts "
+     "(drive forward 2 m)"),
+    ("tomorrow we'll get it to fetch the post", "approach post; grasp post; goto 0, 0;",
+     "you told of an order, imagined one or planned one for later, but did not give it, and the plan acts "
+     "(drive up to the post)"),
     # A convention that acts on one thing does so in the plan; one denied is not done.
     ("fetch the ball, good dog!", "approach ball; grasp dog; goto 0, 0;",
      "the plan goes for the ball but then takes the dog"),
@@ -339,6 +349,8 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     # A thing's name said whole may hold a word of a skill, and one said apart may not be one.
     ("grab the left glove", "grasp left_glove;"),
     ("pick up the bottle of water", "grasp water_bottle;"),
+    # An order said again is given now.
+    ("like I said, turn left", "turnleft 1.5708;"),
 ])
 def test_a_plan_that_does_what_was_said_has_no_doubt(task: str, program: str, profile: Profile) -> None:
     assert reasons(task, program, profile, ["cup", "table", "keys"]) == []
