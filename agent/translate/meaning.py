@@ -102,6 +102,10 @@ _FRAMED = re.compile(r"\b(?:told|tells?|asked|asks?|wants?|wanted) (?:me|us|him|
                      r"|\b(?:should|could|would|might|must)(?:n'?t)? (?:have|'ve)\b|\b(?:should|could)'ve\b"
                      r"|\bif i (?:asked|told|wanted) you\b|\bwhat (?:would|will) happen if\b|\bwhat (?:happens )?if\b"
                      r"|\b(?:later|tomorrow|tonight|next (?:week|time|month|year)|some ?day|one day|in the future)\b")
+# The robot itself named as what moves ("turn yourself", "swivel the whole robot", "on your wheels") asks for
+# the part that moves it as a whole; a vocative ("robot, look up") names no thing to move.
+_SELF = re.compile(r"\b(?:yourself|(?:your|the|its) (?:whole |entire )?(?:body|self|robot|chassis|wheels)"
+                   r"|whole (?:robot|thing|body)|on (?:your |its )?wheels)\b")
 _TOLERANCE = 0.02
 
 
@@ -132,7 +136,8 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     named = _named(WORD.findall(text), vocab)
     doubts: list[Doubt] = []
     doubts += _parts(plan, vocab, words, set(WORD.findall(negated)), named, profile,
-                     _asked_by_unlisted_verbs(affirmed, vocab) | _points_asked(affirmed, plan, vocab) | taken_ways,
+                     _asked_by_unlisted_verbs(affirmed, vocab) | _points_asked(affirmed, plan, vocab) | taken_ways
+                     | ({WHOLE} if _SELF.search(affirmed) else set()),
                      _asked_by_command_verbs(affirmed, vocab))
     doubts += _directions(plan, vocab, words, named, profile)
     doubts += _numbers(text, plan, vocab, profile)

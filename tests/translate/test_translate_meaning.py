@@ -164,6 +164,11 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
      'you said "forget the turn", but the plan still does it (turn left 90°)'),
     ("drive forward without turning", "forward 1; turnleft 1.5708;",
      'you said "without turning", but the plan still does it (turn left 90°)'),
+    # The robot itself said as what moves asks for the base, whatever the verb.
+    ("swivel the whole robot round to the left 45 degrees", "lookleft 0.7854;",
+     "you asked about the base, but the plan moves the head (look left 45°)"),
+    ("swivel right thirty degrees on your wheels", "lookright 0.5236;",
+     "you asked about the base, but the plan moves the head (look right 30°)"),
     # A block said a number of times is done that many times, a shape's sides counted in.
     ("trace a square: one meter forward, turn left, four times", "forward 1; turnleft 1.5708; " * 5,
      "you said 4 times, but the plan does drive forward 1 m, then turn left 90° 5 times"),
@@ -351,6 +356,8 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     ("pick up the bottle of water", "grasp water_bottle;"),
     # An order said again is given now.
     ("like I said, turn left", "turnleft 1.5708;"),
+    # A vocative names no thing to move.
+    ("robot, look up 20 degrees", "lookup 0.3491;"),
 ])
 def test_a_plan_that_does_what_was_said_has_no_doubt(task: str, program: str, profile: Profile) -> None:
     assert reasons(task, program, profile, ["cup", "table", "keys"]) == []
