@@ -148,6 +148,11 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
     ("tomorrow we'll get it to fetch the post", "approach post; grasp post; goto 0, 0;",
      "you told of an order, imagined one or planned one for later, but did not give it, and the plan acts "
      "(drive up to the post)"),
+    # What the speaker is about to do or did is no order.
+    ("I'm going to turn left at the roundabout on my way home", "turnleft 1.5708;",
+     "you told what you are doing or did, not what the robot should do, and the plan acts (turn left 90°)"),
+    ("we just drove forward two metres", "forward 2;",
+     "you told what you are doing or did, not what the robot should do, and the plan acts (drive forward 2 m)"),
     # A convention that acts on one thing does so in the plan; one denied is not done.
     ("fetch the ball, good dog!", "approach ball; grasp dog; goto 0, 0;",
      "the plan goes for the ball but then takes the dog"),
@@ -356,6 +361,8 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     ("pick up the bottle of water", "grasp water_bottle;"),
     # An order said again is given now.
     ("like I said, turn left", "turnleft 1.5708;"),
+    # Saying what the speaker will ask for still asks.
+    ("I'm going to ask you to turn left", "turnleft 1.5708;"),
     # A vocative names no thing to move.
     ("robot, look up 20 degrees", "lookup 0.3491;"),
 ])
