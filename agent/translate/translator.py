@@ -323,8 +323,8 @@ class Translator:
 
         "Drive forward 4 m and turn left, actually skip the turn" comes out with the turn: the model reads
         the take-back as words, not as an edit. The check that doubts it knows which steps were taken
-        back, so leaving them out costs no generation. The model did write them, so the plan is always
-        put to the person.
+        back, so leaving them out costs no generation. What is left passes every check and is only what
+        the person asked for, so it is judged as any such plan is, on the model's own signal.
         """
         dropped = {i for d in judged.doubts if d.check == "cancelled" for i in d.steps}
         if not dropped:
@@ -333,12 +333,9 @@ class Translator:
         passing = self._passing(kept, state.probabilities, normalized, known)
         if passing is None:
             return None
-        program, plan_kept, probabilities, assessment = passing
         said = explain(Plan(tuple(c for i, c in enumerate(plan) if i in dropped), plan.profile), self.profile)
         progress.debug("the plan still did what the task took back (%s); without it, it passes the checks", said)
-        taken_back = Doubt("taken back", f"the model's plan also did what you took back ({said}); "
-                                         "this one leaves it out")
-        return program, plan_kept, probabilities, with_doubt(assessment, taken_back)
+        return passing
 
     def _shorter_ending(self, state: _ClauseState, normalized: str, known: Collection[str] | None
                         ) -> _Candidate | None:
