@@ -106,12 +106,12 @@ _FRAMED = re.compile(r"\b(?:told|tells?|asked|asks?|wants?|wanted) (?:me|us|him|
 # the part that moves it as a whole; a vocative ("robot, look up") names no thing to move.
 _SELF = re.compile(r"\b(?:yourself|(?:your|the|its) (?:whole |entire )?(?:body|self|robot|chassis|wheels)"
                    r"|whole (?:robot|thing|body)|on (?:your |its )?wheels)\b")
-# What the speaker is about to do or did is no order: "I'm going to turn left at the roundabout", "we just
-# drove forward". "I'm going to ask you to turn left" and "I'm going to need you to" still ask.
+# What the speaker is about to do is no order: "I'm going to turn left at the roundabout". "I'm going to ask
+# you to turn left" and "I'm going to need you to" still ask.
 _NARRATED = re.compile(r"\b(?:i|we)(?:'m| am|'re| are) (?:going to|gonna|about to) "
-                       r"(?!(?:ask|get|have|need|want|make|let|tell)\b)"
-                       r"|^(?:[a-z]+, )?(?:i|we) (?:just |already |then )?"
-                       r"(?:turned|went|drove|looked|walked|moved|picked|grabbed|backed|reversed)\b")
+                       r"(?!(?:ask|get|have|need|want|make|let|tell)\b)")
+# ... nor what the speaker did, told with a skill's word in the past: "we just turned left".
+_DONE_BY_SPEAKER = re.compile(r"^(?:[a-z]+, )?(?:i|we) (?:just |already |then )?([a-z]+ed)\b")
 _TOLERANCE = 0.02
 
 
@@ -163,13 +163,24 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     if _FRAMED.search(text):
         doubts.append(Doubt("framed", f"you told of an order, imagined one or planned one for later, but did not "
                                       f"give it, and the plan acts ({say(plan.commands[0], profile)})"))
-    if _NARRATED.search(text):
+    done = _DONE_BY_SPEAKER.match(text)
+    if _NARRATED.search(text) or (done is not None and done.group(1) in _past_forms(vocab.skill_words)):
         doubts.append(Doubt("narrated", f"you told what you are doing or did, not what the robot should do, and "
                                         f"the plan acts ({say(plan.commands[0], profile)})"))
     if _QUESTION.match(text):
         doubts.append(Doubt("question", f"you asked a question, not for the robot to act, but the plan acts "
                                         f"({say(plan.commands[0], profile)})"))
     return tuple({d.reason: d for d in doubts}.values())
+
+
+def _past_forms(words: Iterable[str]) -> set[str]:
+    """The regular past forms of `words`: "turned", "moved", "grabbed"."""
+    forms = set()
+    for word in words:
+        forms |= {word + "ed", word + "d"}
+        if len(word) >= 3 and word[-1] not in "aeiouwxy" and word[-2] in "aeiou" and word[-3] not in "aeiou":
+            forms.add(word + word[-1] + "ed")
+    return forms
 
 
 def _words(text: str, vocab: Vocabulary) -> set[str]:

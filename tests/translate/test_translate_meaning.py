@@ -151,7 +151,7 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
     # What the speaker is about to do or did is no order.
     ("I'm going to turn left at the roundabout on my way home", "turnleft 1.5708;",
      "you told what you are doing or did, not what the robot should do, and the plan acts (turn left 90°)"),
-    ("we just drove forward two metres", "forward 2;",
+    ("we just moved forward two metres", "forward 2;",
      "you told what you are doing or did, not what the robot should do, and the plan acts (drive forward 2 m)"),
     # A convention that acts on one thing does so in the plan; one denied is not done.
     ("fetch the ball, good dog!", "approach ball; grasp dog; goto 0, 0;",
