@@ -118,13 +118,20 @@ def _drop_fillers(tokens: list[str]) -> list[str]:
     i = 0
     while i < len(tokens):
         for phrase in _FILLERS:
-            if tuple(tokens[i:i + len(phrase)]) == phrase:
-                i += len(phrase)
+            end = i + len(phrase)
+            if tuple(tokens[i:end]) == phrase and not _asks_whether(phrase, tokens[end:end + 1]):
+                i = end
                 break
         else:
             out.append(tokens[i])
             i += 1
     return out
+
+
+def _asks_whether(phrase: tuple[str, ...], following: list[str]) -> bool:
+    """Whether a polite "can you" is a question instead: "can you see the cup?" asks whether the robot sees
+    it, and with "can you" dropped it would read as an order to look."""
+    return phrase[-1] == "you" and following == ["see"]
 
 
 # A number is never followed by a determiner, so "go too the fridge" is "go to the fridge".

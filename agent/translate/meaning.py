@@ -89,10 +89,11 @@ _ONLY = (re.compile(r"\bonly (?:with |using )?(?:your |the |its )?([a-z]+)"), re
 # "why don't you look up" suggests ("don't" is no auxiliary here), and a request after it
 # ("what are you waiting for, go forward") is one.
 # A question about what was done ("did you go forward earlier") is no request either; "can you",
-# "would you" and "do you mind" ask for the act, so only the past and perfect auxiliaries count.
+# "would you" and "do you mind" ask for the act, so only the past and perfect auxiliaries count, and
+# "can you see" asks whether the robot sees, not for it to look.
 _QUESTION = re.compile(r"^(?:[a-z]+, )?(?:(?:why|what|where|when|who|which|how) "
                        r"(?:do|does|did|is|are|was|were|have|has|had|can|could|will|would|should)"
-                       r"|(?:did|was|were|have|has|had) (?:you|it|we|they|i))\b(?!')"
+                       r"|(?:did|was|were|have|has|had) (?:you|it|we|they|i)|(?:can|could|do) you see)\b(?!')"
                        r"(?!.*\bthen\b)[^,;.]*$")
 # An order told of, imagined or planned for later is not given now: "she told me to turn left",
 # "my dad always said, turn around", "you should have gone back", "if I asked you to fetch it",

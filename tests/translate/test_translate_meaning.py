@@ -138,6 +138,9 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
      "you asked a question, not for the robot to act, but the plan acts (drive forward 2 m)"),
     ("have you looked up at the shelf yet", "lookup 0.5236;",
      "you asked a question, not for the robot to act, but the plan acts (look up 30°)"),
+    # ... and so is whether the robot sees a thing: "can you" is no politeness here.
+    ("Can you see the cup?", "perceive;",
+     "you asked a question, not for the robot to act, but the plan acts (look for objects)"),
     # An order told of, imagined or planned for later is not given now.
     ("my sister told me to turn left at the end of the road", "turnleft 1.5708;",
      "you told of an order, imagined one or planned one for later, but did not give it, and the plan acts "

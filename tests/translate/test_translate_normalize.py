@@ -21,6 +21,8 @@ from agent.normalize import normalize_task
         ("go to minus three point five, two", "go to -3.5, 2"),
         ("go to 1, -2", "go to 1, -2"),
         ("Could you go a meter and a half forward?", "go 1.5 m forward"),
+        ("Can you see the cup?", "can you see the cup"),
+        ("could you please see what is in front of you", "see what is in front of you"),
         ("spin two full turns", "spin 12.5664 rad"),
         ("turn half a turn", "turn 3.1416 rad"),
         ("move 3 feet", "move 0.9144 m"),
