@@ -154,6 +154,7 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     doubts += _restated(text, plan, vocab, profile)
     doubts += _doubled(text, plan, profile)
     doubts += _ways_gone(affirmed, plan, vocab)
+    doubts += _way_unsaid(affirmed, plan, vocab, profile)
     doubts += _cancelled(text, plan, vocab, profile)
     doubts += _only(affirmed, plan, vocab, named, profile)
     affirmed_named = _named(WORD.findall(affirmed), vocab)
@@ -541,6 +542,39 @@ def _ways_gone(affirmed: str, plan: Plan, vocab: Vocabulary) -> list[Doubt]:
             continue
         doubts.append(Doubt("way", f"you said {token}, but the plan never goes {token}"))
     return list({d.reason: d for d in doubts}.values())
+
+
+def _way_unsaid(affirmed: str, plan: Plan, vocab: Vocabulary, profile: Profile) -> list[Doubt]:
+    """A step gone the other way than a convention goes when no way is said: "spin in a full circle" turns
+    as its example does, and a plan that turns the other way by that amount was not asked for.
+
+    Only a task that says no way, and no word naming only that step ("reverse" names a drive back), is read.
+    """
+    words = set(WORD.findall(affirmed))
+    if words & vocab.way_skills.keys():
+        return []
+    readings = {c.phrase: c for c in vocab.conventions}
+    unsaid = []  # (the skill that goes the other way, its amounts, the convention)
+    for convention in profile.conventions:
+        reading = readings.get(convention.phrase)
+        if reading is None or set(WORD.findall(convention.task)) & vocab.way_skills.keys():
+            continue
+        gone = [s for s in reading.skills if s in vocab.opposites and vocab.opposites[s] not in reading.skills]
+        if len(gone) != 1:
+            continue
+        other = vocab.opposites[gone[0]]
+        if not words & (vocab.step_words.get(other, frozenset()) - vocab.step_words.get(gone[0], frozenset())):
+            unsaid.append((other, reading.amounts, convention))
+    doubts = []
+    for i, step in enumerate(plan.commands):
+        amounts = [a for a in step.args if isinstance(a, Quantity)]
+        match = next((c for other, said, c in unsaid if step.skill == other and amounts
+                      and any(_close(amounts[0].value, v) for v in said.get(amounts[0].unit, ()))), None)
+        if match is not None:
+            doubts.append(Doubt("unsaid way", f'you did not say which way, and "{match.task}" goes as '
+                                       f"{match.program.strip()} does, but the plan goes the other way "
+                                       f"({say(step, profile)})", (i,)))
+    return doubts
 
 
 def _cancelled(text: str, plan: Plan, vocab: Vocabulary, profile: Profile) -> list[Doubt]:

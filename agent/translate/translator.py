@@ -40,10 +40,10 @@ from agent.translate.prompt import (
     system_text,
 )
 from agent.translate.result import Attempt, TranslationResult
-from agent.translate.vocabulary import skill_words
+from agent.translate.vocabulary import skill_words, vocabulary
 from rsl.compiler import compile_program
 from rsl.diagnostics import Code, Diagnostic
-from rsl.plan import Plan, Quantity, format_number
+from rsl.plan import Command, Plan, Quantity, format_number
 from rsl.profile import IDENTIFIER, Convention, Profile
 from rsl.syntax import NO_PROGRAM
 
@@ -279,6 +279,7 @@ class Translator:
             generating = timings["prompt"] + timings["generate"]
             if len(states) == 1 and assessment.doubts:
                 other = (self._without_taken_back(states[0], plan, assessment, normalized, known)
+                         or self._way_as_said(states[0], plan, assessment, normalized, known)
                          or self._shorter_ending(states[0], normalized, known)
                          or self._other_choice(states[0], normalized, known, cancel, timings)
                          or self._clause_by_clause(normalized, plan, assessment, known, cancel, timings))
@@ -335,6 +336,26 @@ class Translator:
             return None
         said = explain(Plan(tuple(c for i, c in enumerate(plan) if i in dropped), plan.profile), self.profile)
         progress.debug("the plan still did what the task took back (%s); without it, it passes the checks", said)
+        return passing
+
+    def _way_as_said(self, state: _ClauseState, plan: Plan, judged: Assessment, normalized: str,
+                     known: Collection[str] | None) -> _Candidate | None:
+        """The plan with the steps that went the other way than the profile's convention turned its way,
+        where the task said no way and the rest passes the checks.
+
+        "Spin in a full circle" means what its convention's example does; the model sometimes turns the
+        other way by the same amount. The check knows which steps, so turning them costs no generation, and
+        the plan is judged on the model's own signal, as the take-back mend's is.
+        """
+        turned = {i for d in judged.doubts if d.check == "unsaid way" for i in d.steps}
+        if not turned:
+            return None
+        opposites = vocabulary(self.profile).opposites
+        mended = "".join((Command(opposites[c.skill], c.args, c.line, c.column) if i in turned else c).to_rsl()
+                         + "\n" for i, c in enumerate(plan))
+        passing = self._passing(mended, state.probabilities, normalized, known)
+        if passing is not None:
+            progress.debug("the plan went the other way than the task's convention; turned, it passes the checks")
         return passing
 
     def _shorter_ending(self, state: _ClauseState, normalized: str, known: Collection[str] | None

@@ -249,6 +249,25 @@ def test_what_is_left_after_the_take_back_must_pass_the_checks_too(translator: T
                                           normalized, None) is None
 
 
+def test_a_step_gone_the_other_way_than_the_convention_is_turned_and_judged_on_the_model(
+        translator: Translator) -> None:
+    task = "Spin in a full circle, then grab the cup."
+    normalized, plan, judged = _read_whole(translator, task, "turnright 6.2832;\ngrasp cup;\n")
+    found = translator._way_as_said(_whole_state(task, "turnright 6.2832;\ngrasp cup;\n"), plan, judged,
+                                    normalized, None)
+    assert found is not None
+    program, _plan, probabilities, assessment = found
+    assert program == "turnleft 6.2832;\ngrasp cup;\n" and probabilities == (0.9, 0.95)
+    assert assessment.doubts == () and not assessment.unsure
+
+
+def test_a_way_said_keeps_the_plan_as_the_model_wrote_it(translator: Translator) -> None:
+    task = "turn right in a full circle"
+    normalized, plan, judged = _read_whole(translator, task, "turnright 6.2832;\n")
+    assert translator._way_as_said(_whole_state(task, "turnright 6.2832;\n"), plan, judged, normalized,
+                                   None) is None
+
+
 def test_a_clause_that_reads_as_no_task_gives_no_step_of_the_clause_by_clause_reading(adapted: Translator) -> None:
     # Read whole, the shipped adapter pans the head that was to be kept still.
     task = "Keep your head still and turn right 45 degrees."

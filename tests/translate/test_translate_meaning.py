@@ -223,6 +223,10 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
      "you took back 90° for 45°, but the plan does both (turn left 90°, then turn right 45°)"),
     # A number is taken back by one in its own unit: a turn after "no" corrects no distance.
     ("drive two meters, no, turn left 90 degrees", "turnleft 1.5708;", "you said 2 m, but the plan never uses it"),
+    # With no way said, a convention's amount goes the way its example does.
+    ("Spin in a full circle", "turnright 6.2832;",
+     'you did not say which way, and "spin in a full circle" goes as turnleft 6.2832; does, but the plan goes '
+     "the other way (turn right 360°)"),
     # "take a left" asks for a turn of the base, not the head.
     ("take a left", "lookleft 0.5236;", "you asked about the base, but the plan moves the head (look left 30°)"),
     # A thing's name made of words said apart, one of them an action.
@@ -288,6 +292,9 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     ("why not turn left", "turnleft 1.5708;"),
     # A question followed by a request.
     ("what are you waiting for? go forward", "forward 1;"),
+    # A word that names only the step says its way.
+    ("reverse half a meter", "backward 0.5;"),
+    ("turn right in a full circle", "turnright 6.2832;"),
     # A question that asks for the act is a request.
     ("could you turn left", "turnleft 1.5708;"),
     ("would you go forward a meter", "forward 1;"),
