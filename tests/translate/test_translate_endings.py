@@ -3,6 +3,9 @@ whole program fails a meaning check."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 from agent.normalize import normalize_task
 from agent.translate import Translator
 from agent.translate.automaton import RslAutomaton
@@ -220,11 +223,16 @@ def _whole_state(task: str, program: str) -> _ClauseState:
     return state
 
 
+def _mended(mend: Callable[..., Any], translator: Translator, task: str, program: str) -> Any:
+    """What `mend` (a translator method that mends a doubted whole reading) makes of `program` read whole."""
+    normalized, plan, judged = _read_whole(translator, task, program)
+    return mend(_whole_state(task, program), plan, judged, normalized, None)
+
+
 def test_a_step_taken_back_is_left_out_and_the_rest_judged_on_the_model(translator: Translator) -> None:
-    task = "Drive forward four metres and turn left, actually skip the turn."
-    normalized, plan, judged = _read_whole(translator, task, "forward 4;\nturnleft 1.5708;\n")
-    found = translator._without_taken_back(_whole_state(task, "forward 4;\nturnleft 1.5708;\n"), plan, judged,
-                                           normalized, None)
+    found = _mended(translator._without_taken_back, translator,
+                    "Drive forward four metres and turn left, actually skip the turn.",
+                    "forward 4;\nturnleft 1.5708;\n")
     assert found is not None
     program, kept, probabilities, assessment = found
     assert program == "forward 4;\n" and len(kept) == 1 and probabilities == (0.9, 0.95)
@@ -234,27 +242,23 @@ def test_a_step_taken_back_is_left_out_and_the_rest_judged_on_the_model(translat
 
 def test_nothing_is_left_out_of_a_plan_no_take_back_doubts(translator: Translator) -> None:
     task = "turn around to the right"
-    normalized, plan, judged = _read_whole(translator, task, "turnleft 3.1416;\n")
+    _normalized, _plan, judged = _read_whole(translator, task, "turnleft 3.1416;\n")
     assert judged.doubts
-    assert translator._without_taken_back(_whole_state(task, "turnleft 3.1416;\n"), plan, judged,
-                                          normalized, None) is None
+    assert _mended(translator._without_taken_back, translator, task, "turnleft 3.1416;\n") is None
 
 
 def test_what_is_left_after_the_take_back_must_pass_the_checks_too(translator: Translator) -> None:
     # Without the drive, the 1 m said for it is unused: still doubted, so not taken.
     task = "Move forward one metre, then look down. Actually, skip moving, just look down."
-    normalized, plan, judged = _read_whole(translator, task, "forward 1;\nlookdown 0.5236;\n")
+    _normalized, _plan, judged = _read_whole(translator, task, "forward 1;\nlookdown 0.5236;\n")
     assert any(d.check == "cancelled" for d in judged.doubts)
-    assert translator._without_taken_back(_whole_state(task, "forward 1;\nlookdown 0.5236;\n"), plan, judged,
-                                          normalized, None) is None
+    assert _mended(translator._without_taken_back, translator, task, "forward 1;\nlookdown 0.5236;\n") is None
 
 
 def test_a_step_gone_the_other_way_than_the_convention_is_turned_and_judged_on_the_model(
         translator: Translator) -> None:
-    task = "Spin in a full circle, then grab the cup."
-    normalized, plan, judged = _read_whole(translator, task, "turnright 6.2832;\ngrasp cup;\n")
-    found = translator._way_as_said(_whole_state(task, "turnright 6.2832;\ngrasp cup;\n"), plan, judged,
-                                    normalized, None)
+    found = _mended(translator._way_as_said, translator, "Spin in a full circle, then grab the cup.",
+                    "turnright 6.2832;\ngrasp cup;\n")
     assert found is not None
     program, _plan, probabilities, assessment = found
     assert program == "turnleft 6.2832;\ngrasp cup;\n" and probabilities == (0.9, 0.95)
@@ -262,10 +266,7 @@ def test_a_step_gone_the_other_way_than_the_convention_is_turned_and_judged_on_t
 
 
 def test_a_way_said_keeps_the_plan_as_the_model_wrote_it(translator: Translator) -> None:
-    task = "turn right in a full circle"
-    normalized, plan, judged = _read_whole(translator, task, "turnright 6.2832;\n")
-    assert translator._way_as_said(_whole_state(task, "turnright 6.2832;\n"), plan, judged, normalized,
-                                   None) is None
+    assert _mended(translator._way_as_said, translator, "turn right in a full circle", "turnright 6.2832;\n") is None
 
 
 def test_a_clause_that_reads_as_no_task_gives_no_step_of_the_clause_by_clause_reading(adapted: Translator) -> None:
