@@ -27,7 +27,7 @@ from agent.translate.clauses import SHAPES
 from agent.translate.explain import quantity, say
 from agent.translate.names import DETERMINERS
 from agent.translate.vocabulary import NUMBER_UNIT, WHOLE, WORD, ConventionReading, Vocabulary, vocabulary
-from rsl.plan import ObjectRef, Plan, Quantity
+from rsl.plan import Command, ObjectRef, Plan, Quantity
 from rsl.profile import Profile
 
 _COUNT = re.compile(r"\b(\d+) times\b")
@@ -554,7 +554,7 @@ def _way_unsaid(affirmed: str, plan: Plan, vocab: Vocabulary, profile: Profile) 
     if words & vocab.way_skills.keys():
         return []
     readings = {c.phrase: c for c in vocab.conventions}
-    unsaid = []  # (the skill that goes the other way, its amounts, the convention)
+    unsaid = []  # (the skill that goes the other way, the convention's skill, its amounts, its example task)
     for convention in profile.conventions:
         reading = readings.get(convention.phrase)
         if reading is None or set(WORD.findall(convention.task)) & vocab.way_skills.keys():
@@ -564,16 +564,17 @@ def _way_unsaid(affirmed: str, plan: Plan, vocab: Vocabulary, profile: Profile) 
             continue
         other = vocab.opposites[gone[0]]
         if not words & (vocab.step_words.get(other, frozenset()) - vocab.step_words.get(gone[0], frozenset())):
-            unsaid.append((other, reading.amounts, convention))
+            unsaid.append((other, gone[0], reading.amounts, convention.task))
     doubts = []
     for i, step in enumerate(plan.commands):
         amounts = [a for a in step.args if isinstance(a, Quantity)]
-        match = next((c for other, said, c in unsaid if step.skill == other and amounts
+        match = next(((way, task) for other, way, said, task in unsaid if step.skill == other and amounts
                       and any(_close(amounts[0].value, v) for v in said.get(amounts[0].unit, ()))), None)
         if match is not None:
-            doubts.append(Doubt("unsaid way", f'you did not say which way, and "{match.task}" goes as '
-                                       f"{match.program.strip()} does, but the plan goes the other way "
-                                       f"({say(step, profile)})", (i,)))
+            way, task = match
+            doubts.append(Doubt("unsaid way", f'you did not say which way, so it goes as "{task}" does '
+                                              f"({say(Command(way, step.args, step.line, step.column), profile)}), "
+                                              f"but the plan goes the other way ({say(step, profile)})", (i,)))
     return doubts
 
 

@@ -225,8 +225,8 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
     ("drive two meters, no, turn left 90 degrees", "turnleft 1.5708;", "you said 2 m, but the plan never uses it"),
     # With no way said, a convention's amount goes the way its example does.
     ("Spin in a full circle", "turnright 6.2832;",
-     'you did not say which way, and "spin in a full circle" goes as turnleft 6.2832; does, but the plan goes '
-     "the other way (turn right 360°)"),
+     'you did not say which way, so it goes as "spin in a full circle" does (turn left 360°), but the plan '
+     "goes the other way (turn right 360°)"),
     # "take a left" asks for a turn of the base, not the head.
     ("take a left", "lookleft 0.5236;", "you asked about the base, but the plan moves the head (look left 30°)"),
     # A thing's name made of words said apart, one of them an action.
