@@ -166,23 +166,13 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
         doubts.append(Doubt("framed", f"you told of an order, imagined one or planned one for later, but did not "
                                       f"give it, and the plan acts ({say(plan.commands[0], profile)})"))
     done = _DONE_BY_SPEAKER.match(text)
-    if _NARRATED.search(text) or (done is not None and done.group(1) in _past_forms(vocab.skill_words)):
+    if _NARRATED.search(text) or (done is not None and done.group(1) in vocab.past_forms):
         doubts.append(Doubt("narrated", f"you told what you are doing or did, not what the robot should do, and "
                                         f"the plan acts ({say(plan.commands[0], profile)})"))
     if _QUESTION.match(text):
         doubts.append(Doubt("question", f"you asked a question, not for the robot to act, but the plan acts "
                                         f"({say(plan.commands[0], profile)})"))
     return tuple({d.reason: d for d in doubts}.values())
-
-
-def _past_forms(words: Iterable[str]) -> set[str]:
-    """The regular past forms of `words`: "turned", "moved", "grabbed"."""
-    forms = set()
-    for word in words:
-        forms |= {word + "ed", word + "d"}
-        if len(word) >= 3 and word[-1] not in "aeiouwxy" and word[-2] in "aeiou" and word[-3] not in "aeiou":
-            forms.add(word + word[-1] + "ed")
-    return forms
 
 
 def _words(text: str, vocab: Vocabulary) -> set[str]:
@@ -553,28 +543,18 @@ def _way_unsaid(affirmed: str, plan: Plan, vocab: Vocabulary, profile: Profile) 
     words = set(WORD.findall(affirmed))
     if words & vocab.way_skills.keys():
         return []
-    readings = {c.phrase: c for c in vocab.conventions}
-    unsaid = []  # (the skill that goes the other way, the convention's skill, its amounts, its example task)
-    for convention in profile.conventions:
-        reading = readings.get(convention.phrase)
-        if reading is None or set(WORD.findall(convention.task)) & vocab.way_skills.keys():
-            continue
-        gone = [s for s in reading.skills if s in vocab.opposites and vocab.opposites[s] not in reading.skills]
-        if len(gone) != 1:
-            continue
-        other = vocab.opposites[gone[0]]
-        if not words & (vocab.step_words.get(other, frozenset()) - vocab.step_words.get(gone[0], frozenset())):
-            unsaid.append((other, gone[0], reading.amounts, convention.task))
+    unsaid = [u for u in vocab.unsaid_ways
+              if not words & (vocab.step_words.get(u.against, frozenset()) - vocab.step_words.get(u.way, frozenset()))]
     doubts = []
     for i, step in enumerate(plan.commands):
         amounts = [a for a in step.args if isinstance(a, Quantity)]
-        match = next(((way, task) for other, way, said, task in unsaid if step.skill == other and amounts
-                      and any(_close(amounts[0].value, v) for v in said.get(amounts[0].unit, ()))), None)
+        match = next((u for u in unsaid if step.skill == u.against and amounts
+                      and any(_close(amounts[0].value, v) for v in u.amounts.get(amounts[0].unit, ()))), None)
         if match is not None:
-            way, task = match
-            doubts.append(Doubt("unsaid way", f'you did not say which way, so it goes as "{task}" does '
-                                              f"({say(Command(way, step.args, step.line, step.column), profile)}), "
-                                              f"but the plan goes the other way ({say(step, profile)})", (i,)))
+            said_way = say(Command(match.way, step.args, step.line, step.column), profile)
+            doubts.append(Doubt("unsaid way", f'you did not say which way, so it goes as "{match.task}" does '
+                                              f"({said_way}), but the plan goes the other way "
+                                              f"({say(step, profile)})", (i,)))
     return doubts
 
 

@@ -45,6 +45,21 @@ class Vocabulary:
     # The first word of a whole command that is no skill's word ("face" of "face behind") -> the parts
     # its program moves.
     command_verbs: dict[str, frozenset[str]]
+    # What goes which way when no way is said: from each convention whose example task says none and whose
+    # program goes one way ("spin in a full circle": turnleft 6.2832).
+    unsaid_ways: tuple[UnsaidWay, ...]
+    past_forms: frozenset[str]  # the skill words' regular past forms ("turned", "grabbed")
+
+
+@dataclass(frozen=True)
+class UnsaidWay:
+    """A convention's one way, taken when a task says none: a step of `against` by one of `amounts` went
+    the other way than `way`, the skill of the convention's example `task`."""
+
+    against: str
+    way: str
+    amounts: dict[str, frozenset[float]]
+    task: str
 
 
 @dataclass(frozen=True)
@@ -169,6 +184,11 @@ def _build_vocabulary(profile: Profile) -> Vocabulary:
     for c in conventions:
         if c.whole and c.words and c.words[0] not in known_words:
             command_verbs.setdefault(c.words[0], set()).update(parts.get(k, WHOLE) for k in c.skills)
+    unsaid_ways = []
+    for convention, reading in zip(profile.conventions, conventions, strict=True):
+        gone = [k for k in reading.skills if k in opposites and opposites[k] not in reading.skills]
+        if len(gone) == 1 and not set(WORD.findall(convention.task)) & way_skills.keys():
+            unsaid_ways.append(UnsaidWay(opposites[gone[0]], gone[0], reading.amounts, convention.task))
     amount_phrases = "|".join(re.escape(c.phrase) for c in conventions if c.amounts and not c.whole and not c.default)
     return Vocabulary(parts=parts, part_words=part_words, directions=tuple(ways),
                        convention_numbers={u: frozenset(v) for u, v in numbers.items()},
@@ -178,7 +198,18 @@ def _build_vocabulary(profile: Profile) -> Vocabulary:
                        part_verbs=frozenset(w for p, ws in part_words.items() if p != WHOLE for w in ws) - set(nouns),
                        known_words=known_words,
                        way_and_amount=re.compile(rf"\s+([a-z]+)\s+(?:\d*\.?\d+|{amount_phrases})\b"),
-                       command_verbs={w: frozenset(ps) for w, ps in command_verbs.items()})
+                       command_verbs={w: frozenset(ps) for w, ps in command_verbs.items()},
+                       unsaid_ways=tuple(unsaid_ways), past_forms=_past_forms(skill_word_set))
+
+
+def _past_forms(words: frozenset[str]) -> frozenset[str]:
+    """The regular past forms of `words`: "turned", "moved", "grabbed"."""
+    forms = set()
+    for word in words:
+        forms |= {word + "ed", word + "d"}
+        if len(word) >= 3 and word[-1] not in "aeiouwxy" and word[-2] in "aeiou" and word[-3] not in "aeiou":
+            forms.add(word + word[-1] + "ed")
+    return frozenset(forms)
 
 
 _VOCABULARIES: dict[tuple[str, str], Vocabulary] = {}
