@@ -198,6 +198,16 @@ class PartBack:
 
 
 @dataclass(frozen=True)
+class FrameWay:
+    """Words that say which way a point lies from the start along one axis of the workspace ("2 m ahead",
+    "1 m to your right"): the checks read a point said so against the plan's drive to a point."""
+
+    axis: str  # "x" or "y", as the workspace names them
+    sign: int  # 1 toward the axis's positive end, -1 away
+    phrases: tuple[str, ...]  # lowercase words said after the amount, e.g. "in front"
+
+
+@dataclass(frozen=True)
 class Motion:
     """The profile's `[motion]` table."""
 
@@ -233,6 +243,7 @@ class Profile:
     digest: str = field(repr=False)
     cannot: tuple[Inability, ...] = ()
     back: tuple[PartBack, ...] = ()
+    frame: tuple[FrameWay, ...] = ()
     source: str = field(repr=False, default="")
 
     def skill(self, keyword: str) -> Skill | None:
@@ -344,6 +355,12 @@ def _build(data: dict[str, Any], source: str) -> Profile:
             raise fail(f"[[back]] #{index}: part {part!r} is not a part the robot's description names "
                        f"(its parts: {', '.join(parts)})")
         back.append(PartBack(part=part.lower(), phrases=phrases))
+    frame = []
+    for index, toward, phrases in _phrase_tables(data, "frame", "toward", 'an axis\'s end, "+x" or "-y"', fail):
+        if len(toward) != 2 or toward[0] not in "+-" or toward[1:] not in workspace:
+            raise fail(f"[[frame]] #{index}: toward {toward!r} must be + or - and an axis of the workspace "
+                       f"({', '.join(sorted(workspace))}), such as \"+x\"")
+        frame.append(FrameWay(axis=toward[1:], sign=1 if toward[0] == "+" else -1, phrases=phrases))
     max_statements = read_settings(_Limits, data.get("limits", {}), error=ProfileError, source=source,
                                    prefix="limits.", docs="docs/skills.md").max_statements
 
@@ -361,6 +378,7 @@ def _build(data: dict[str, Any], source: str) -> Profile:
         source=source,
         cannot=tuple(cannot),
         back=tuple(back),
+        frame=tuple(frame),
     )
 
 

@@ -113,6 +113,11 @@ _NARRATED = re.compile(r"\b(?:i|we)(?:'m| am|'re| are) (?:going to|gonna|about t
                        r"(?!(?:ask|get|have|need|want|make|let|tell)\b)")
 # ... nor what the speaker did, told with a skill's word in the past: "we just turned left".
 _DONE_BY_SPEAKER = re.compile(r"^(?:[a-z]+, )?(?:i|we) (?:just |already |then )?([a-z]+ed)\b")
+# A point's way followed by "of" says what the point lies from; only the start or the robot itself is read
+# ("1 m left of the start", "2 m in front of where you started"), not "1 m left of the table".
+_OF_START = re.compile(r" of (?:the start|your start|the starting|where you|you\b|yourself\b|it\b|here\b)")
+# A coordinate named ("x 2, y -1"): the point is said by its coordinates, not from the start.
+_COORDINATE_NAMED = re.compile(r"\b[xy]\b")
 _TOLERANCE = 0.02
 
 
@@ -155,6 +160,7 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     doubts += _doubled(text, plan, profile)
     doubts += _ways_gone(affirmed, plan, vocab)
     doubts += _way_unsaid(affirmed, plan, vocab, profile)
+    doubts += _point_from_start(text, plan, vocab, named, profile)
     doubts += _cancelled(text, plan, vocab, profile)
     doubts += _only(affirmed, plan, vocab, named, profile)
     affirmed_named = _named(WORD.findall(affirmed), vocab)
@@ -556,6 +562,81 @@ def _way_unsaid(affirmed: str, plan: Plan, vocab: Vocabulary, profile: Profile) 
                                               f"({said_way}), but the plan goes the other way "
                                               f"({say(step, profile)})", (i,)))
     return doubts
+
+
+def said_point(text: str, profile: Profile) -> dict[str, float] | None:
+    """The point a task says by amounts and ways from the start ("the spot 2 m ahead and 1 m to your right":
+    x 2, y -1), by axis; None when it says none, says an axis twice, or gives the point whole or by its
+    coordinates. `text` is normalized and lower-case.
+    """
+    vocab = vocabulary(profile)
+    if _POINT.search(text) or _COORDINATE_NAMED.search(text):
+        return None
+    point: dict[str, float] = {}
+    for m in vocab.point_offset.finditer(text):
+        if text.startswith(" of ", m.end()) and not _OF_START.match(text, m.end()):
+            return None
+        axis, sign = vocab.frame[m.group(2)]
+        if axis in point:
+            return None
+        point[axis] = sign * float(m.group(1))
+    return point or None
+
+
+def at_point(step: Command, point: dict[str, float], profile: Profile) -> Command | None:
+    """`step`, a drive to a point, driving to `point` instead (an axis not in it is 0)."""
+    skill = profile.skill(step.skill)
+    if skill is None or len(skill.params) != len(step.args) or not all(p.axis for p in skill.params):
+        return None
+    return Command(step.skill, tuple(Quantity(point.get(str(p.axis), 0.0), p.unit) for p in skill.params),
+                   step.line, step.column)
+
+
+def _point_from_start(text: str, plan: Plan, vocab: Vocabulary, named: list[ConventionReading],
+                      profile: Profile) -> list[Doubt]:
+    """A drive to a point said from the start goes to that point, and the point's amounts are not driven
+    again after it as steps of their own ("2 m ahead and 1 m to your right" is one drive to (2, -1)).
+
+    Only a plan with one drive to a point, and no other move of the base before it, is read: from
+    anywhere else the start's ways are not the robot's. A convention that drives to a point of its own
+    ("back to the start") leaves the task unread.
+    """
+    point = said_point(text, profile)
+    if point is None or any(vocab.coordinates & c.skills for c in named):
+        return []
+    gotos = [i for i, c in enumerate(plan) if c.skill in vocab.coordinates]
+    if len(gotos) != 1:
+        return []
+    at = gotos[0]
+    said = {abs(v) for v in point.values()}
+    spent = []
+    for i, c in enumerate(plan.commands):
+        if i == at or vocab.parts.get(c.skill) != WHOLE:
+            continue
+        if i < at:
+            return []
+        if any(a.unit == "m" and any(_close(abs(a.value), v) for v in said) for a in c.args
+               if isinstance(a, Quantity)):
+            spent.append(i)
+    goto = plan.commands[at]
+    meant = at_point(goto, point, profile)
+    there = meant is not None and all(_close(a.value, b.value) for a, b in zip(goto.args, meant.args, strict=True)
+                                      if isinstance(a, Quantity) and isinstance(b, Quantity))
+    if meant is None or (there and not spent):
+        return []
+    ways = " and ".join(m.group(0) for m in vocab.point_offset.finditer(text))
+    said_where = f"you said the point {ways} from the start, {_where(meant)}"
+    also = f"{say(plan.commands[spent[0]], profile)} as well" if spent else ""
+    if there:
+        reason = f"{said_where}, and the plan drives there but does {also}"
+    else:
+        reason = f"{said_where}, but the plan drives to {_where(goto)}" + (f" and does {also}" if also else "")
+    return [Doubt("point", reason, (at, *spent))]
+
+
+def _where(step: Command) -> str:
+    """A drive to a point's coordinates as people read them: "(2 m, -1 m)"."""
+    return "(" + ", ".join(quantity(a) for a in step.args if isinstance(a, Quantity)) + ")"
 
 
 def _cancelled(text: str, plan: Plan, vocab: Vocabulary, profile: Profile) -> list[Doubt]:

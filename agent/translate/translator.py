@@ -25,7 +25,7 @@ from agent.translate.clauses import Clause, split_clauses
 from agent.translate.confidence import Assessment, assess, model_signal, result_fields, with_doubt
 from agent.translate.engine import FORK_RECORD_FLOOR, CancelFlag, Fork, Generation
 from agent.translate.explain import explain
-from agent.translate.meaning import Doubt
+from agent.translate.meaning import Doubt, at_point, said_point
 from agent.translate.misheard import heard
 from agent.translate.model_path import ModelNotFoundError
 from agent.translate.names import DETERMINERS, FUNCTION_WORDS, NOT_NAMES, offered_names
@@ -280,6 +280,7 @@ class Translator:
             if len(states) == 1 and assessment.doubts:
                 other = (self._without_taken_back(states[0], plan, assessment, normalized, known)
                          or self._way_as_said(states[0], plan, assessment, normalized, known)
+                         or self._point_as_said(states[0], plan, assessment, normalized, known)
                          or self._shorter_ending(states[0], normalized, known)
                          or self._other_choice(states[0], normalized, known, cancel, timings)
                          or self._clause_by_clause(normalized, plan, assessment, known, cancel, timings))
@@ -356,6 +357,27 @@ class Translator:
         passing = self._passing(mended, state.probabilities, normalized, known)
         if passing is not None:
             progress.debug("the plan went the other way than the task's convention; turned, it passes the checks")
+        return passing
+
+    def _point_as_said(self, state: _ClauseState, plan: Plan, judged: Assessment, normalized: str,
+                       known: Collection[str] | None) -> _Candidate | None:
+        """The plan driving to the point the task said from the start, without the steps that drove that
+        point's amounts again, where the rest passes the checks.
+
+        "The spot 2 m ahead and 1 m to your right" is exact once the profile's frame reads it; the model
+        often swaps the axes or loses a sign. The check knows the steps, so mending them costs no
+        generation, and the plan is judged on the model's own signal, as the other mends' are.
+        """
+        steps = next((d.steps for d in judged.doubts if d.check == "point"), ())
+        point = said_point(normalized.lower(), self.profile) if steps else None
+        meant = at_point(plan.commands[steps[0]], point, self.profile) if steps and point else None
+        if meant is None:
+            return None
+        mended = "".join((meant if i == steps[0] else c).to_rsl() + "\n" for i, c in enumerate(plan)
+                         if i not in steps[1:])
+        passing = self._passing(mended, state.probabilities, normalized, known)
+        if passing is not None:
+            progress.debug("the plan drove elsewhere than the point said from the start; mended, it passes")
         return passing
 
     def _shorter_ending(self, state: _ClauseState, normalized: str, known: Collection[str] | None

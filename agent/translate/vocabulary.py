@@ -49,6 +49,10 @@ class Vocabulary:
     # program goes one way ("spin in a full circle": turnleft 6.2832).
     unsaid_ways: tuple[UnsaidWay, ...]
     past_forms: frozenset[str]  # the skill words' regular past forms ("turned", "grabbed")
+    # An amount in metres and the way from the start it is said to lie ("2 m to your right"), from the
+    # profile's [[frame]]; and each way's phrase -> (axis, sign).
+    point_offset: re.Pattern[str]
+    frame: dict[str, tuple[str, int]]
 
 
 @dataclass(frozen=True)
@@ -189,6 +193,9 @@ def _build_vocabulary(profile: Profile) -> Vocabulary:
         gone = [k for k in reading.skills if k in opposites and opposites[k] not in reading.skills]
         if len(gone) == 1 and not set(WORD.findall(convention.task)) & way_skills.keys():
             unsaid_ways.append(UnsaidWay(opposites[gone[0]], gone[0], reading.amounts, convention.task))
+    frame = {phrase: (way.axis, way.sign) for way in profile.frame for phrase in way.phrases}
+    # The longest phrase first, so "to your right" is read whole rather than as "right" alone.
+    frame_phrases = "|".join(re.escape(p) for p in sorted(frame, key=len, reverse=True)) or "(?!)"
     amount_phrases = "|".join(re.escape(c.phrase) for c in conventions if c.amounts and not c.whole and not c.default)
     return Vocabulary(parts=parts, part_words=part_words, directions=tuple(ways),
                        convention_numbers={u: frozenset(v) for u, v in numbers.items()},
@@ -199,7 +206,9 @@ def _build_vocabulary(profile: Profile) -> Vocabulary:
                        known_words=known_words,
                        way_and_amount=re.compile(rf"\s+([a-z]+)\s+(?:\d*\.?\d+|{amount_phrases})\b"),
                        command_verbs={w: frozenset(ps) for w, ps in command_verbs.items()},
-                       unsaid_ways=tuple(unsaid_ways), past_forms=_past_forms(skill_word_set))
+                       unsaid_ways=tuple(unsaid_ways), past_forms=_past_forms(skill_word_set),
+                       point_offset=re.compile(rf"(?<![\w.])(\d*\.?\d+) m ({frame_phrases})\b"),
+                       frame=frame)
 
 
 def _past_forms(words: frozenset[str]) -> frozenset[str]:

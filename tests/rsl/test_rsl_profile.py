@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import pytest
 
 from rsl.codegen import to_python
@@ -115,6 +117,27 @@ def test_a_part_put_back_must_be_a_part_of_the_robot_with_its_words(table, compl
     with pytest.raises(ProfileError, match=complaint):
         parse_profile(text, source="broken.toml")
 
+
+
+@pytest.mark.parametrize(("table", "complaint"), [
+    ('toward = "+z"\nphrases = ["up"]',
+     r"\[\[frame\]\] #\d+: toward '\+z' must be \+ or - and an axis of the workspace \(x, y\)"),
+    ('toward = "x"\nphrases = ["ahead"]', "toward 'x' must be"),
+    ('toward = "+x"\nphrases = []', "needs `toward`"),
+])
+def test_a_frame_way_needs_a_signed_axis_of_the_workspace_and_its_words(table, complaint):
+    text = default_profile_path().read_text() + "\n[[frame]]\n" + table + "\n"
+    with pytest.raises(ProfileError, match=complaint):
+        parse_profile(text, source="broken.toml")
+
+
+def test_the_default_robot_reads_points_from_its_start_without_touching_the_language(profile):
+    ways = {(w.axis, w.sign): w.phrases for w in profile.frame}
+    assert "ahead" in ways[("x", 1)] and "behind" in ways[("x", -1)]
+    assert "to your left" in ways[("y", 1)] and "to your right" in ways[("y", -1)]
+    text = default_profile_path().read_text()
+    without = re.sub(r"\[\[frame\]\]\ntoward = .*\nphrases = .*\n", "", text)
+    assert without != text and parse_profile(without).digest == profile.digest
 
 
 @pytest.mark.parametrize(("table", "complaint"), [

@@ -269,6 +269,19 @@ def test_a_way_said_keeps_the_plan_as_the_model_wrote_it(translator: Translator)
     assert _mended(translator._way_as_said, translator, "turn right in a full circle", "turnright 6.2832;\n") is None
 
 
+def test_a_point_said_from_the_start_is_driven_to_and_judged_on_the_model(translator: Translator) -> None:
+    found = _mended(translator._point_as_said, translator,
+                    "Go to a point one metre to your right and two metres forward.", "goto 1, 2;\nforward 2;\n")
+    assert found is not None
+    program, _plan, probabilities, assessment = found
+    assert program == "goto 2, -1;\n" and probabilities == (0.9, 0.95)
+    assert assessment.doubts == () and not assessment.unsure
+
+
+def test_a_point_said_by_coordinates_keeps_the_plan_as_the_model_wrote_it(translator: Translator) -> None:
+    assert _mended(translator._point_as_said, translator, "go to x 1, y 2", "goto 2, 1;\n") is None
+
+
 def test_a_clause_that_reads_as_no_task_gives_no_step_of_the_clause_by_clause_reading(adapted: Translator) -> None:
     # Read whole, the shipped adapter pans the head that was to be kept still.
     task = "Keep your head still and turn right 45 degrees."

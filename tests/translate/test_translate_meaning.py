@@ -227,6 +227,15 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
     ("Spin in a full circle", "turnright 6.2832;",
      'you did not say which way, so it goes as "spin in a full circle" does (turn left 360°), but the plan '
      "goes the other way (turn right 360°)"),
+    # A point said from the start by amounts and ways is that point, driven to once.
+    ("Go to the position two metres behind the start.", "goto 2, 0;",
+     "you said the point 2 m behind from the start, (-2 m, 0 m), but the plan drives to (2 m, 0 m)"),
+    ("go to a point one metre to your right and two metres forward", "goto 1, 2; forward 2;",
+     "you said the point 1 m to your right and 2 m forward from the start, (2 m, -1 m), but the plan drives to "
+     "(1 m, 2 m) and does drive forward 2 m as well"),
+    ("drive to the spot 3 metres ahead and 2 metres to the left", "goto 3, 2; forward 2;",
+     "you said the point 3 m ahead and 2 m to the left from the start, (3 m, 2 m), and the plan drives there but "
+     "does drive forward 2 m as well"),
     # "take a left" asks for a turn of the base, not the head.
     ("take a left", "lookleft 0.5236;", "you asked about the base, but the plan moves the head (look left 30°)"),
     # A thing's name made of words said apart, one of them an action.
@@ -295,6 +304,11 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     # A word that names only the step says its way.
     ("reverse half a meter", "backward 0.5;"),
     ("turn right in a full circle", "turnright 6.2832;"),
+    # A point said from the start, driven to; from elsewhere than the start, its ways are not the robot's.
+    ("Drive to the spot one metre left of the start.", "goto 0, 1;"),
+    ("Move to the point half a metre to the right of where you started.", "goto 0, -0.5;"),
+    ("turn left, then go to the point 2 metres ahead", "turnleft 1.5708; goto 0, 2;"),
+    ("go to the spot 1 metre left of the table", "goto 1, 1;"),
     # A question that asks for the act is a request.
     ("could you turn left", "turnleft 1.5708;"),
     ("would you go forward a meter", "forward 1;"),
