@@ -66,6 +66,11 @@ _RESTATED = re.compile(r"(?<![\w.])(\d*\.?\d+) (m|rad),((?: [a-z']+){0,3}?),? (\
 # Words that ask for a step once more without a count.
 _AGAIN_WORDS = ("again", "another", "more")
 _AGAIN = re.compile(rf"\b(?:{'|'.join(_AGAIN_WORDS)}|repeat\w*|twice)\b")
+# A clause that only asks for what came before once more ("and repeat that once more", "do it again",
+# "same again"): its words, and those of them that ask.
+_REPEAT_WORDS = frozenset({"and", "then", "now", "do", "that", "it", "this", "the", "all", "of", "whole", "thing",
+                           "please", "repeat", "same", "again", "once", "more", "1", "one", "time"})
+_REPEAT_ASKS = frozenset({"repeat", "same", "again", "more"})
 _SEQUENCE_WORDS = frozenset({"and", "then", "after", "next", "finally", "times", *_AGAIN_WORDS})
 # What negates what follows it up to the end of its clause ("don't move, just look left"), and a part
 # kept still ("keep your head still and turn left", "keep your head where it is"). "why don't you look up"
@@ -155,6 +160,7 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     doubts += _numbers(text, plan, vocab, profile)
     doubts += _totals(text, plan, vocab, named)
     doubts += _repeated_after(text, plan, profile)
+    doubts += _again(text, plan, profile)
     doubts += _repetitions(text, plan, profile)
     doubts += _restated(text, plan, vocab, profile)
     doubts += _doubled(text, plan, profile)
@@ -330,8 +336,22 @@ def _said_numbers(text: str) -> list[tuple[float, str]]:
             if m.start(1) not in dropped]
 
 
+def _repeats_said(text: str) -> int:
+    """How many clauses at the end of `text` ask only for everything before them once more
+    ("go forward 1 m, and again, and again": 2); 0 where such a clause comes before another step or
+    nothing comes before it."""
+    clauses = [c.split() for c in re.split(r"[,;]|\.(?!\d)", text) if c.strip()]
+    repeats = 0
+    while clauses and set(clauses[-1]) <= _REPEAT_WORDS and set(clauses[-1]) & _REPEAT_ASKS:
+        clauses.pop()
+        repeats += 1
+    if not clauses or any(set(c) <= _REPEAT_WORDS and set(c) & _REPEAT_ASKS for c in clauses):
+        return 0
+    return repeats
+
+
 def _counts(text: str) -> int:
-    count = 1
+    count = 1 + _repeats_said(text)
     for found in _COUNT.findall(text):
         count *= max(1, int(found))
     for sides in _sides_said(text):
@@ -402,6 +422,27 @@ def _totals(text: str, plan: Plan, vocab: Vocabulary, named: list[ConventionRead
             doubts.append(Doubt("total", f"you said {quantity(Quantity(limit, unit))} of {noun} in all, "
                                          f"but the plan {verb} {quantity(Quantity(planned, unit))}"))
     return doubts
+
+
+def _again(text: str, plan: Plan, profile: Profile) -> list[Doubt]:
+    """What the task asks for once more at its end ("..., and repeat that once more") is done again: the
+    plan repeats a step, or does an amount said that many times over in one."""
+    repeats = _repeats_said(text)
+    steps = [(c.skill, c.args) for c in plan]
+    if not repeats or len(set(steps)) < len(steps):
+        return []
+    said = [v for v, _u in _said_numbers(text)]
+    amounts = [abs(a.value) for c in plan for a in c.args if isinstance(a, Quantity)]
+    if any(_close(a, v * (repeats + 1)) for a in amounts for v in said):
+        return []
+    done = ", then ".join(say(c, profile) for c in plan.commands)
+    return [Doubt("again", f"you asked for it {repeats + 1} times in all, but the plan does it once ({done})",
+                  tuple(range(len(steps))))]
+
+
+def repeated(plan: Plan, text: str) -> str:
+    """The program of `plan` done as many times as the end of `text` asks ("..., and again": twice)."""
+    return plan.to_rsl() * (1 + _repeats_said(text))
 
 
 def _repeated_after(text: str, plan: Plan, profile: Profile) -> list[Doubt]:

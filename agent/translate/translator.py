@@ -25,7 +25,7 @@ from agent.translate.clauses import Clause, split_clauses
 from agent.translate.confidence import Assessment, assess, model_signal, result_fields, with_doubt
 from agent.translate.engine import FORK_RECORD_FLOOR, CancelFlag, Fork, Generation
 from agent.translate.explain import explain
-from agent.translate.meaning import Doubt, at_point, said_point
+from agent.translate.meaning import Doubt, at_point, repeated, said_point
 from agent.translate.misheard import heard
 from agent.translate.model_path import ModelNotFoundError
 from agent.translate.names import DETERMINERS, FUNCTION_WORDS, NOT_NAMES, offered_names
@@ -281,6 +281,7 @@ class Translator:
                 other = (self._without_taken_back(states[0], plan, assessment, normalized, known)
                          or self._way_as_said(states[0], plan, assessment, normalized, known)
                          or self._point_as_said(states[0], plan, assessment, normalized, known)
+                         or self._done_again(states[0], plan, assessment, normalized, known)
                          or self._shorter_ending(states[0], normalized, known)
                          or self._other_choice(states[0], normalized, known, cancel, timings)
                          or self._clause_by_clause(normalized, plan, assessment, known, cancel, timings))
@@ -378,6 +379,22 @@ class Translator:
         passing = self._passing(mended, state.probabilities, normalized, known)
         if passing is not None:
             progress.debug("the plan drove elsewhere than the point said from the start; mended, it passes")
+        return passing
+
+    def _done_again(self, state: _ClauseState, plan: Plan, judged: Assessment, normalized: str,
+                    known: Collection[str] | None) -> _Candidate | None:
+        """The plan done again as many times as the task's end asks ("..., and repeat that once more"), where
+        the checks found it done once and the repeats pass them.
+
+        The model reads "do that again" as words and writes the steps once; what "that" is, everything said
+        before, is the plan itself, so repeating it costs no generation. It is judged on the model's own
+        signal, as the other mends are.
+        """
+        if not any(d.check == "again" for d in judged.doubts):
+            return None
+        passing = self._passing(repeated(plan, normalized.lower()), state.probabilities, normalized, known)
+        if passing is not None:
+            progress.debug("the task asked for its steps again and the plan did them once; repeated, it passes")
         return passing
 
     def _shorter_ending(self, state: _ClauseState, normalized: str, known: Collection[str] | None

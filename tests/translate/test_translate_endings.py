@@ -282,6 +282,21 @@ def test_a_point_said_by_coordinates_keeps_the_plan_as_the_model_wrote_it(transl
     assert _mended(translator._point_as_said, translator, "go to x 1, y 2", "goto 2, 1;\n") is None
 
 
+def test_what_the_end_asks_for_again_is_repeated_and_judged_on_the_model(translator: Translator) -> None:
+    found = _mended(translator._done_again, translator,
+                    "Rotate left 30 degrees and move forward 2 meters, and repeat that once more.",
+                    "turnleft 0.5236;\nforward 2;\n")
+    assert found is not None
+    program, _plan, probabilities, assessment = found
+    assert program == "turnleft 0.5236;\nforward 2;\nturnleft 0.5236;\nforward 2;\n"
+    assert probabilities == (0.9, 0.95) and assessment.doubts == () and not assessment.unsure
+
+
+def test_again_inside_a_step_is_not_a_repeat_of_the_whole(translator: Translator) -> None:
+    assert _mended(translator._done_again, translator, "go forward 2 metres, then turn left again",
+                   "forward 2;\nturnleft 1.5708;\n") is None
+
+
 def test_a_clause_that_reads_as_no_task_gives_no_step_of_the_clause_by_clause_reading(adapted: Translator) -> None:
     # Read whole, the shipped adapter pans the head that was to be kept still.
     task = "Keep your head still and turn right 45 degrees."

@@ -236,6 +236,13 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
     ("drive to the spot 3 metres ahead and 2 metres to the left", "goto 3, 2; forward 2;",
      "you said the point 3 m ahead and 2 m to the left from the start, (3 m, 2 m), and the plan drives there but "
      "does drive forward 2 m as well"),
+    # What the end of the task asks for once more is done again.
+    ("Turn left 45 degrees. Do that again.", "turnleft 0.7854;",
+     "you asked for it 2 times in all, but the plan does it once (turn left 45°)"),
+    ("Nudge forward a little, and again, and again.", "forward 0.2;",
+     "you asked for it 3 times in all, but the plan does it once (drive forward 20 cm)"),
+    ("Rotate left 30 degrees and move forward 2 meters, and repeat that once more.", "turnleft 0.5236; forward 2;",
+     "you asked for it 2 times in all, but the plan does it once (turn left 30°, then drive forward 2 m)"),
     # "take a left" asks for a turn of the base, not the head.
     ("take a left", "lookleft 0.5236;", "you asked about the base, but the plan moves the head (look left 30°)"),
     # A thing's name made of words said apart, one of them an action.
@@ -309,6 +316,13 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     ("Move to the point half a metre to the right of where you started.", "goto 0, -0.5;"),
     ("turn left, then go to the point 2 metres ahead", "turnleft 1.5708; goto 0, 2;"),
     ("go to the spot 1 metre left of the table", "goto 1, 1;"),
+    # Asked for again, and done again.
+    ("Turn left 45 degrees. Do that again.", "turnleft 0.7854; turnleft 0.7854;"),
+    ("Back up a meter, then once more.", "backward 1; backward 1;"),
+    ("Turn right 90 degrees, please. And again. And again.",
+     "turnright 1.5708; turnright 1.5708; turnright 1.5708;"),
+    # "again" inside a step asks for that step, not for all before it once more.
+    ("go forward 2 metres, then turn left again", "forward 2; turnleft 1.5708;"),
     # A question that asks for the act is a request.
     ("could you turn left", "turnleft 1.5708;"),
     ("would you go forward a meter", "forward 1;"),
