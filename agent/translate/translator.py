@@ -333,12 +333,9 @@ class Translator:
         if not dropped:
             return None
         kept = "".join(c.to_rsl() + "\n" for i, c in enumerate(plan) if i not in dropped)
-        passing = self._passing(kept, state.probabilities, normalized, known)
-        if passing is None:
-            return None
         said = explain(Plan(tuple(c for i, c in enumerate(plan) if i in dropped), plan.profile), self.profile)
-        progress.debug("the plan still did what the task took back (%s); without it, it passes the checks", said)
-        return passing
+        return self._mend_passing(kept, state, normalized, known, f"the plan still did what the task took back "
+                                                                  f"({said}); left out")
 
     def _way_as_said(self, state: _ClauseState, plan: Plan, judged: Assessment, normalized: str,
                      known: Collection[str] | None) -> _Candidate | None:
@@ -355,10 +352,8 @@ class Translator:
         opposites = vocabulary(self.profile).opposites
         mended = "".join((Command(opposites[c.skill], c.args, c.line, c.column) if i in turned else c).to_rsl()
                          + "\n" for i, c in enumerate(plan))
-        passing = self._passing(mended, state.probabilities, normalized, known)
-        if passing is not None:
-            progress.debug("the plan went the other way than the task's convention; turned, it passes the checks")
-        return passing
+        return self._mend_passing(mended, state, normalized, known,
+                                  "the plan went the other way than the task's convention; turned")
 
     def _point_as_said(self, state: _ClauseState, plan: Plan, judged: Assessment, normalized: str,
                        known: Collection[str] | None) -> _Candidate | None:
@@ -376,10 +371,8 @@ class Translator:
             return None
         mended = "".join((meant if i == steps[0] else c).to_rsl() + "\n" for i, c in enumerate(plan)
                          if i not in steps[1:])
-        passing = self._passing(mended, state.probabilities, normalized, known)
-        if passing is not None:
-            progress.debug("the plan drove elsewhere than the point said from the start; mended, it passes")
-        return passing
+        return self._mend_passing(mended, state, normalized, known,
+                                  "the plan drove elsewhere than the point said from the start; set to it")
 
     def _done_again(self, state: _ClauseState, plan: Plan, judged: Assessment, normalized: str,
                     known: Collection[str] | None) -> _Candidate | None:
@@ -392,9 +385,16 @@ class Translator:
         """
         if not any(d.check == "again" for d in judged.doubts):
             return None
-        passing = self._passing(repeated(plan, normalized.lower()), state.probabilities, normalized, known)
+        return self._mend_passing(repeated(plan, normalized.lower()), state, normalized, known,
+                                  "the task asked for its steps again and the plan did them once; repeated")
+
+    def _mend_passing(self, mended: str, state: _ClauseState, normalized: str, known: Collection[str] | None,
+                      what: str) -> _Candidate | None:
+        """`mended`, the program a mend made of a doubted plan without generating, when it passes every
+        check; it is judged on the first reading's own signal. `what` says what was mended, for -v."""
+        passing = self._passing(mended, state.probabilities, normalized, known)
         if passing is not None:
-            progress.debug("the task asked for its steps again and the plan did them once; repeated, it passes")
+            progress.debug("%s, it passes the checks", what)
         return passing
 
     def _shorter_ending(self, state: _ClauseState, normalized: str, known: Collection[str] | None

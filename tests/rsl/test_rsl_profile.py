@@ -113,10 +113,7 @@ def test_profile_settings_are_checked_like_every_other_setting(patch, replacemen
     ('phrases = ["head back"]', "needs `part`"),
 ])
 def test_a_part_put_back_must_be_a_part_of_the_robot_with_its_words(table, complaint):
-    text = default_profile_path().read_text() + "\n[[back]]\n" + table + "\n"
-    with pytest.raises(ProfileError, match=complaint):
-        parse_profile(text, source="broken.toml")
-
+    _refused_with("back", table, complaint)
 
 
 @pytest.mark.parametrize(("table", "complaint"), [
@@ -126,9 +123,7 @@ def test_a_part_put_back_must_be_a_part_of_the_robot_with_its_words(table, compl
     ('toward = "+x"\nphrases = []', "needs `toward`"),
 ])
 def test_a_frame_way_needs_a_signed_axis_of_the_workspace_and_its_words(table, complaint):
-    text = default_profile_path().read_text() + "\n[[frame]]\n" + table + "\n"
-    with pytest.raises(ProfileError, match=complaint):
-        parse_profile(text, source="broken.toml")
+    _refused_with("frame", table, complaint)
 
 
 def test_the_default_robot_reads_points_from_its_start_without_touching_the_language(profile):
@@ -146,9 +141,15 @@ def test_the_default_robot_reads_points_from_its_start_without_touching_the_lang
     ('what = "water plants"\nphrases = ["Forward "]', "phrase 'forward' is a word for the skill `forward`"),
 ])
 def test_what_a_robot_cannot_do_needs_its_sentence_and_words_that_are_no_skill(table, complaint):
-    text = default_profile_path().read_text() + "\n[[cannot]]\n" + table + "\n"
+    _refused_with("cannot", table, complaint)
+
+
+def _refused_with(name, table, complaint):
+    """The default profile with one more `[[name]]` table is refused with `complaint`."""
+    text = default_profile_path().read_text() + f"\n[[{name}]]\n" + table + "\n"
     with pytest.raises(ProfileError, match=complaint):
         parse_profile(text, source="broken.toml")
+
 
 def test_the_default_robot_puts_its_head_back(profile):
     assert [b.part for b in profile.back] == ["head"]

@@ -6,6 +6,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+import pytest
+
 from agent.normalize import normalize_task
 from agent.translate import Translator
 from agent.translate.automaton import RslAutomaton
@@ -229,17 +231,6 @@ def _mended(mend: Callable[..., Any], translator: Translator, task: str, program
     return mend(_whole_state(task, program), plan, judged, normalized, None)
 
 
-def test_a_step_taken_back_is_left_out_and_the_rest_judged_on_the_model(translator: Translator) -> None:
-    found = _mended(translator._without_taken_back, translator,
-                    "Drive forward four metres and turn left, actually skip the turn.",
-                    "forward 4;\nturnleft 1.5708;\n")
-    assert found is not None
-    program, kept, probabilities, assessment = found
-    assert program == "forward 4;\n" and len(kept) == 1 and probabilities == (0.9, 0.95)
-    # What is left passes every check and is only what was asked: nothing marks it as doubted.
-    assert assessment.doubts == () and assessment.model == 0.9 and not assessment.unsure
-
-
 def test_nothing_is_left_out_of_a_plan_no_take_back_doubts(translator: Translator) -> None:
     task = "turn around to the right"
     _normalized, _plan, judged = _read_whole(translator, task, "turnleft 3.1416;\n")
@@ -255,46 +246,35 @@ def test_what_is_left_after_the_take_back_must_pass_the_checks_too(translator: T
     assert _mended(translator._without_taken_back, translator, task, "forward 1;\nlookdown 0.5236;\n") is None
 
 
-def test_a_step_gone_the_other_way_than_the_convention_is_turned_and_judged_on_the_model(
-        translator: Translator) -> None:
-    found = _mended(translator._way_as_said, translator, "Spin in a full circle, then grab the cup.",
-                    "turnright 6.2832;\ngrasp cup;\n")
+@pytest.mark.parametrize(("mend", "task", "program", "mended"), [
+    ("_without_taken_back", "Drive forward four metres and turn left, actually skip the turn.",
+     "forward 4;\nturnleft 1.5708;\n", "forward 4;\n"),
+    ("_way_as_said", "Spin in a full circle, then grab the cup.", "turnright 6.2832;\ngrasp cup;\n",
+     "turnleft 6.2832;\ngrasp cup;\n"),
+    ("_point_as_said", "Go to a point one metre to your right and two metres forward.", "goto 1, 2;\nforward 2;\n",
+     "goto 2, -1;\n"),
+    ("_done_again", "Rotate left 30 degrees and move forward 2 meters, and repeat that once more.",
+     "turnleft 0.5236;\nforward 2;\n", "turnleft 0.5236;\nforward 2;\nturnleft 0.5236;\nforward 2;\n"),
+])
+def test_a_mend_writes_what_its_doubt_names_and_judges_it_on_the_model(
+        translator: Translator, mend: str, task: str, program: str, mended: str) -> None:
+    found = _mended(getattr(translator, mend), translator, task, program)
     assert found is not None
-    program, _plan, probabilities, assessment = found
-    assert program == "turnleft 6.2832;\ngrasp cup;\n" and probabilities == (0.9, 0.95)
-    assert assessment.doubts == () and not assessment.unsure
+    written, plan, probabilities, assessment = found
+    assert written == mended and len(plan) == mended.count(";") and probabilities == (0.9, 0.95)
+    # What it wrote passes every check and is only what was asked: nothing marks it as doubted.
+    assert assessment.doubts == () and assessment.model == 0.9 and not assessment.unsure
 
 
-def test_a_way_said_keeps_the_plan_as_the_model_wrote_it(translator: Translator) -> None:
-    assert _mended(translator._way_as_said, translator, "turn right in a full circle", "turnright 6.2832;\n") is None
-
-
-def test_a_point_said_from_the_start_is_driven_to_and_judged_on_the_model(translator: Translator) -> None:
-    found = _mended(translator._point_as_said, translator,
-                    "Go to a point one metre to your right and two metres forward.", "goto 1, 2;\nforward 2;\n")
-    assert found is not None
-    program, _plan, probabilities, assessment = found
-    assert program == "goto 2, -1;\n" and probabilities == (0.9, 0.95)
-    assert assessment.doubts == () and not assessment.unsure
-
-
-def test_a_point_said_by_coordinates_keeps_the_plan_as_the_model_wrote_it(translator: Translator) -> None:
-    assert _mended(translator._point_as_said, translator, "go to x 1, y 2", "goto 2, 1;\n") is None
-
-
-def test_what_the_end_asks_for_again_is_repeated_and_judged_on_the_model(translator: Translator) -> None:
-    found = _mended(translator._done_again, translator,
-                    "Rotate left 30 degrees and move forward 2 meters, and repeat that once more.",
-                    "turnleft 0.5236;\nforward 2;\n")
-    assert found is not None
-    program, _plan, probabilities, assessment = found
-    assert program == "turnleft 0.5236;\nforward 2;\nturnleft 0.5236;\nforward 2;\n"
-    assert probabilities == (0.9, 0.95) and assessment.doubts == () and not assessment.unsure
-
-
-def test_again_inside_a_step_is_not_a_repeat_of_the_whole(translator: Translator) -> None:
-    assert _mended(translator._done_again, translator, "go forward 2 metres, then turn left again",
-                   "forward 2;\nturnleft 1.5708;\n") is None
+@pytest.mark.parametrize(("mend", "task", "program"), [
+    ("_way_as_said", "turn right in a full circle", "turnright 6.2832;\n"),
+    ("_point_as_said", "go to x 1, y 2", "goto 2, 1;\n"),
+    # "again" inside a step asks for that step, not for everything before it once more.
+    ("_done_again", "go forward 2 metres, then turn left again", "forward 2;\nturnleft 1.5708;\n"),
+])
+def test_a_mend_keeps_a_plan_its_doubt_does_not_name(translator: Translator, mend: str, task: str,
+                                                     program: str) -> None:
+    assert _mended(getattr(translator, mend), translator, task, program) is None
 
 
 def test_a_clause_that_reads_as_no_task_gives_no_step_of_the_clause_by_clause_reading(adapted: Translator) -> None:
