@@ -140,11 +140,8 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
                   ) -> tuple[Doubt, ...]:
     """Every disagreement between the normalized `task` and `plan`; empty when they agree."""
     vocab = vocabulary(profile)
-    base_ways = {w for skill, mine, _opposite, theirs in vocab.directions
-                 if vocab.parts.get(skill, WHOLE) == WHOLE for w in mine | theirs}
-    taken_ways = {WHOLE for m in _TAKE_A_WAY.finditer(task.lower()) if m.group(1) in base_ways}
-    carried = _TAKE_A_WAY.sub(lambda m: "" if m.group(1) in base_ways else m.group(0), task.lower())
-    text = _ASKED_DOING.sub(lambda m: f"{m.group(1)} to {_stem(m.group(2), vocab)}", _LIGHT_VERB.sub("", carried))
+    text, took_a_way = _as_read(task, vocab)
+    taken_ways = {WHOLE} if took_a_way else set()
     # A bare "no" before a correction ("left, no, make that right") takes a word back, not the clause.
     negated = " ".join(m.group(0) for m in _NEGATION.finditer(text) if m.group(0).strip() not in MARKERS)
     affirmed = _NEGATION.sub(lambda m: m.group(0) if m.group(0).strip() in MARKERS else " ", text)
@@ -185,6 +182,19 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
         doubts.append(Doubt("question", f"you asked a question, not for the robot to act, but the plan acts "
                                         f"({say(plan.commands[0], profile)})"))
     return tuple({d.reason: d for d in doubts}.values())
+
+
+def _as_read(task: str, vocab: Vocabulary) -> tuple[str, bool]:
+    """The normalized `task` as the checks read it, and whether "take" carried a way of the base ("take a
+    left", which asks for the base): lower-case, with a verb that only carries a way or a noun of looking
+    left out, and an "-ing" form after "mind", "before" or "after" read as its verb."""
+    base_ways = {w for skill, mine, _opposite, theirs in vocab.directions
+                 if vocab.parts.get(skill, WHOLE) == WHOLE for w in mine | theirs}
+    lowered = task.lower()
+    took_a_way = any(m.group(1) in base_ways for m in _TAKE_A_WAY.finditer(lowered))
+    carried = _TAKE_A_WAY.sub(lambda m: "" if m.group(1) in base_ways else m.group(0), lowered)
+    text = _ASKED_DOING.sub(lambda m: f"{m.group(1)} to {_stem(m.group(2), vocab)}", _LIGHT_VERB.sub("", carried))
+    return text, took_a_way
 
 
 def _words(text: str, vocab: Vocabulary) -> set[str]:
@@ -440,9 +450,10 @@ def _again(text: str, plan: Plan, profile: Profile) -> list[Doubt]:
                   tuple(range(len(steps))))]
 
 
-def repeated(plan: Plan, text: str) -> str:
-    """The program of `plan` done as many times as the end of `text` asks ("..., and again": twice)."""
-    return plan.to_rsl() * (1 + _repeats_said(text))
+def repeated(plan: Plan, task: str, profile: Profile) -> str:
+    """The program of `plan` done as many times as the end of the normalized `task` asks ("..., and again":
+    twice), read as the "again" check reads it."""
+    return plan.to_rsl() * (1 + _repeats_said(_as_read(task, vocabulary(profile))[0]))
 
 
 def _repeated_after(text: str, plan: Plan, profile: Profile) -> list[Doubt]:
@@ -605,12 +616,18 @@ def _way_unsaid(affirmed: str, plan: Plan, vocab: Vocabulary, profile: Profile) 
     return doubts
 
 
-def said_point(text: str, profile: Profile) -> dict[str, float] | None:
-    """The point a task says by amounts and ways from the start ("the spot 2 m ahead and 1 m to your right":
-    x 2, y -1), by axis; None when it says none, says an axis twice, or gives the point whole or by its
-    coordinates. `text` is normalized and lower-case.
-    """
+def said_point(task: str, profile: Profile) -> dict[str, float] | None:
+    """The point the normalized `task` says by amounts and ways from the start, read as the "point" check
+    reads it."""
     vocab = vocabulary(profile)
+    return _point_said(_as_read(task, vocab)[0], vocab)
+
+
+def _point_said(text: str, vocab: Vocabulary) -> dict[str, float] | None:
+    """The point `text`, as the checks read it, says by amounts and ways from the start ("the spot 2 m
+    ahead and 1 m to your right": x 2, y -1), by axis; None when it says none, says an axis twice, or gives
+    the point whole or by its coordinates.
+    """
     if _POINT.search(text) or _COORDINATE_NAMED.search(text):
         return None
     point: dict[str, float] = {}
@@ -642,7 +659,7 @@ def _point_from_start(text: str, plan: Plan, vocab: Vocabulary, named: list[Conv
     anywhere else the start's ways are not the robot's. A convention that drives to a point of its own
     ("back to the start") leaves the task unread.
     """
-    point = said_point(text, profile)
+    point = _point_said(text, vocab)
     if point is None or any(vocab.coordinates & c.skills for c in named):
         return []
     gotos = [i for i, c in enumerate(plan) if c.skill in vocab.coordinates]

@@ -365,7 +365,7 @@ class Translator:
         generation, and the plan is judged on the model's own signal, as the other mends' are.
         """
         steps = next((d.steps for d in judged.doubts if d.check == "point"), ())
-        point = said_point(normalized.lower(), self.profile) if steps else None
+        point = said_point(normalized, self.profile) if steps else None
         meant = at_point(plan.commands[steps[0]], point, self.profile) if steps and point else None
         if meant is None:
             return None
@@ -385,7 +385,7 @@ class Translator:
         """
         if not any(d.check == "again" for d in judged.doubts):
             return None
-        return self._mend_passing(repeated(plan, normalized.lower()), state, normalized, known,
+        return self._mend_passing(repeated(plan, normalized, self.profile), state, normalized, known,
                                   "the task asked for its steps again and the plan did them once; repeated")
 
     def _mend_passing(self, mended: str, state: _ClauseState, normalized: str, known: Collection[str] | None,
