@@ -96,18 +96,24 @@ _ONLY = (re.compile(r"\bonly (?:with |using )?(?:your |the |its )?([a-z]+)"), re
 # A question about what was done ("did you go forward earlier") is no request either; "can you",
 # "would you" and "do you mind" ask for the act, so only the past and perfect auxiliaries count, and
 # "can you see" asks whether the robot sees, not for it to look.
+# "How far", "how long" and the like ask about an amount, never for a step; a decimal point ends no clause.
 _QUESTION = re.compile(r"^(?:[a-z]+, )?(?:(?:why|what|where|when|who|which|how) "
                        r"(?:do|does|did|is|are|was|were|have|has|had|can|could|will|would|should)"
+                       r"|how (?:far|long|much|many|fast|often|high|low)|is it possible"
                        r"|(?:did|was|were|have|has|had) (?:you|it|we|they|i)|(?:can|could|do) you see)\b(?!')"
-                       r"(?!.*\bthen\b)[^,;.]*$")
+                       r"(?!.*\bthen\b)(?:[^,;.]|\.(?=\d))*$")
 # An order told of, imagined or planned for later is not given now: "she told me to turn left",
 # "my dad always said, turn around", "you should have gone back", "if I asked you to fetch it",
-# "tomorrow we'll get it to fetch the mail". "Like I said, turn left" repeats an order, so "I" is left out.
+# "tomorrow we'll get it to fetch the mail", "hypothetically, if you had to fetch the cup", "i wish you could
+# turn faster". "Like I said, turn left" repeats an order, so "I" is left out.
 _FRAMED = re.compile(r"\b(?:told|tells?|asked|asks?|wants?|wanted) (?:me|us|him|her|them) to\b"
                      r"|\b(?!i\b)[a-z]+ (?:(?:always|once|just|never|also) )?(?:said|says)\b"
                      r"|\b(?:should|could|would|might|must)(?:n'?t)? (?:have|'ve)\b|\b(?:should|could)'ve\b"
-                     r"|\bif i (?:asked|told|wanted) you\b|\bwhat (?:would|will) happen if\b|\bwhat (?:happens )?if\b"
-                     r"|\b(?:later|tomorrow|tonight|next (?:week|time|month|year)|some ?day|one day|in the future)\b")
+                     r"|\bif i (?:asked|told|wanted|said)\b|\bwhat (?:would|will) happen if\b|\bwhat (?:happens )?if\b"
+                     r"|\b(?:hypothetically|in theory|suppos(?:e|ing)|imagine|if you had to|i wish|eventually)\b"
+                     r"|\b(?:we|i)(?:'ll| will) (?:have|get|teach) you\b"
+                     r"|\b(?:later|tomorrow|tonight|next (?:week|time|month|year)|some ?(?:day|time)|one day"
+                     r"|in the future)\b")
 # The robot itself named as what moves ("turn yourself", "swivel the whole robot", "on your wheels") asks for
 # the part that moves it as a whole; a vocative ("robot, look up") names no thing to move.
 _SELF = re.compile(r"\b(?:yourself|(?:your|the|its) (?:whole |entire )?(?:body|self|robot|chassis|wheels)"
@@ -118,6 +124,17 @@ _NARRATED = re.compile(r"\b(?:i|we)(?:'m| am|'re| are) (?:going to|gonna|about t
                        r"(?!(?:ask|get|have|need|want|make|let|tell)\b)")
 # ... nor what the speaker did, told with a skill's word in the past: "we just turned left".
 _DONE_BY_SPEAKER = re.compile(r"^(?:[a-z]+, )?(?:i|we) (?:just |already |then )?([a-z]+ed)\b")
+# What the robot or someone else did, told at the start of a clause, perhaps after when: "yesterday you
+# turned left twice", "in the demo, the robot grabbed the ball". After "after", "when" or "like" the past
+# is only a time or a manner ("after you turned left, go forward"), so only a clause's first words count.
+_DONE_BY_SOMEONE = re.compile(r"(?:^|, |\band |\bbut )(?:(?:yesterday|earlier|today|before|last [a-z]+"
+                              r"|this [a-z]+|on [a-z]+day)?,? )?(?:the (?:other )?)?(?:you|it|he|she|they|robot)"
+                              r" (?:just |already |then |also |once |never |always |[a-z]+ly )?([a-z]+ed)\b")
+# Everything said so far called off at the end, with no step asked after it: "turn left, actually, never
+# mind", "go to the door and, actually, don't bother", "look up, no, cancel that".
+_CALLED_OFF = re.compile(r"\b(?:never ?mind|(?:forget|scrap|cancel|scratch|ignore) (?:about )?(?:it|that|this|all"
+                         r"(?: of)?(?: that| this| it)?|everything|the whole thing)|ignore me|don'?t bother"
+                         r"|not now|as you were|(?:wait|actually|no),? don'?t(?=,|$)|leave it(?=,|$))\b")
 # A point's way followed by "of" says what the point lies from; only the start or the robot itself is read
 # ("1 m left of the start", "2 m in front of where you started"), not "1 m left of the table".
 _OF_START = re.compile(r" of (?:the start|your start|the starting|where you|you\b|yourself\b|it\b|here\b)")
@@ -181,7 +198,29 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     if _QUESTION.match(text):
         doubts.append(Doubt("question", f"you asked a question, not for the robot to act, but the plan acts "
                                         f"({say(plan.commands[0], profile)})"))
+    called_off = _called_off(text, vocab)
+    if called_off:
+        doubts.append(Doubt("called-off", f'you called it off ("{called_off}"), but the plan still acts '
+                                          f"({say(plan.commands[0], profile)})"))
+    reported = [m for m in _DONE_BY_SOMEONE.finditer(text) if m.group(1) in vocab.past_forms]
+    if reported:
+        told = reported[0].group(0).strip(", ")
+        doubts.append(Doubt("reported", f'you told what was done ("{told}"), not what the robot should do, and '
+                                        f"the plan acts ({say(plan.commands[0], profile)})"))
     return tuple({d.reason: d for d in doubts}.values())
+
+
+def _called_off(text: str, vocab: Vocabulary) -> str:
+    """The words that call off all that was said before, when nothing is asked after them; "" when none."""
+    found = list(_CALLED_OFF.finditer(text))
+    last = found[-1] if found else None
+    if last is None or not text[:last.start()].strip(" ,"):
+        return ""
+    after = text[last.end():]
+    asked = {w for words in vocab.step_words.values() for w in words}
+    if re.search(r"\d", after) or any(_inflected(w, a) for w in WORD.findall(after) for a in asked):
+        return ""
+    return last.group(0)
 
 
 def _as_read(task: str, vocab: Vocabulary) -> tuple[str, bool]:

@@ -250,6 +250,24 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
      "approach crate_look; lookdown 0.2618; perceive;",
      "the plan takes 'crate_look' for one thing's name, but you did not say it so, and 'look' names a direction "
      "or an action"),
+    # Words that ask for nothing now: an order called off, a report of what was done, a question, a wish.
+    ("turn left, actually, never mind", "turnleft 1.5708;",
+     'you called it off ("never mind"), but the plan still acts (turn left 90°)'),
+    ("go to the door and... actually, don't bother", "approach door;",
+     'you called it off ("don\'t bother"), but the plan still acts (drive up to the door)'),
+    ("yesterday you turned left twice and bumped into the sofa", "turnleft 1.5708; turnleft 1.5708;",
+     'you told what was done ("yesterday you turned"), not what the robot should do, and the plan acts '
+     "(turn left 90°)"),
+    ("How far can you go forward in one go?", "forward 1;",
+     "you asked a question, not for the robot to act, but the plan acts (drive forward 1 m)"),
+    ("What would you do if I said turn right ninety degrees?", "turnright 1.5708;",
+     "you asked a question, not for the robot to act, but the plan acts (turn right 90°)"),
+    ("Hypothetically, if you had to fetch the cup, how long would it take?", "approach cup; grasp cup; goto 0, 0;",
+     "you told of an order, imagined one or planned one for later, but did not give it, and the plan acts "
+     "(drive up to the cup)"),
+    ("I wish you could turn around faster", "turnleft 3.1416;",
+     "you told of an order, imagined one or planned one for later, but did not give it, and the plan acts "
+     "(turn left 180°)"),
 ])
 def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str, expected: str,
                                                          profile: Profile) -> None:
@@ -403,6 +421,11 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     ("I'm going to ask you to turn left", "turnleft 1.5708;"),
     # A vocative names no thing to move.
     ("robot, look up 20 degrees", "lookup 0.3491;"),
+    # Calling off one thing, then asking for another, asks for it; so does a time said by a past.
+    ("never mind the cup, just turn left", "turnleft 1.5708;"),
+    ("forget it, go forward 2 metres", "forward 2;"),
+    ("turn left, never mind, turn right", "turnright 1.5708;"),
+    ("when you turned left, go forward 2 metres", "turnleft 1.5708; forward 2;"),
 ])
 def test_a_plan_that_does_what_was_said_has_no_doubt(task: str, program: str, profile: Profile) -> None:
     assert reasons(task, program, profile, ["cup", "table", "keys"]) == []
