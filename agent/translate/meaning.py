@@ -227,11 +227,9 @@ def _as_read(task: str, vocab: Vocabulary) -> tuple[str, bool]:
     """The normalized `task` as the checks read it, and whether "take" carried a way of the base ("take a
     left", which asks for the base): lower-case, with a verb that only carries a way or a noun of looking
     left out, and an "-ing" form after "mind", "before" or "after" read as its verb."""
-    base_ways = {w for skill, mine, _opposite, theirs in vocab.directions
-                 if vocab.parts.get(skill, WHOLE) == WHOLE for w in mine | theirs}
     lowered = task.lower()
-    took_a_way = any(m.group(1) in base_ways for m in _TAKE_A_WAY.finditer(lowered))
-    carried = _TAKE_A_WAY.sub(lambda m: "" if m.group(1) in base_ways else m.group(0), lowered)
+    took_a_way = any(m.group(1) in vocab.base_ways for m in _TAKE_A_WAY.finditer(lowered))
+    carried = _TAKE_A_WAY.sub(lambda m: "" if m.group(1) in vocab.base_ways else m.group(0), lowered)
     text = _ASKED_DOING.sub(lambda m: f"{m.group(1)} to {_stem(m.group(2), vocab)}", _LIGHT_VERB.sub("", carried))
     return text, took_a_way
 
