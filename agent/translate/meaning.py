@@ -135,6 +135,8 @@ _DONE_BY_SOMEONE = re.compile(r"(?:^|, |\band |\bbut )(?:(?:yesterday|earlier|to
 _CALLED_OFF = re.compile(r"\b(?:never ?mind|(?:forget|scrap|cancel|scratch|ignore) (?:about )?(?:it|that|this|all"
                          r"(?: of)?(?: that| this| it)?|everything|the whole thing)|ignore me|don'?t bother"
                          r"|not now|as you were|(?:wait|actually|no),? don'?t(?=,|$)|leave it(?=,|$))\b")
+# A check that finds the words asked for nothing now: such a plan is refused, not put to the person.
+ASKS_NOTHING = frozenset({"framed", "narrated", "question", "called-off"})
 # A point's way followed by "of" says what the point lies from; only the start or the robot itself is read
 # ("1 m left of the start", "2 m in front of where you started"), not "1 m left of the table".
 _OF_START = re.compile(r" of (?:the start|your start|the starting|where you|you\b|yourself\b|it\b|here\b)")
@@ -217,8 +219,10 @@ def _called_off(text: str, vocab: Vocabulary) -> str:
     if last is None or not text[:last.start()].strip(" ,"):
         return ""
     after = text[last.end():]
-    asked = {w for words in vocab.step_words.values() for w in words}
-    if re.search(r"\d", after) or any(_inflected(w, a) for w in WORD.findall(after) for a in asked):
+    # Any word of a skill or the first word of a whole command ("fetch", "explore") asks for a step.
+    asked = vocab.skill_words | {c.words[0] for c in vocab.conventions if c.whole and c.words}
+    if re.search(r"\d", after) or any(w in asked or (len(a) >= 4 and _inflected(w, a))
+                                       for w in WORD.findall(after) for a in asked):
         return ""
     return last.group(0)
 

@@ -25,7 +25,7 @@ from agent.translate.clauses import Clause, split_clauses
 from agent.translate.confidence import Assessment, assess, model_signal, result_fields, with_doubt
 from agent.translate.engine import FORK_RECORD_FLOOR, CancelFlag, Fork, Generation
 from agent.translate.explain import explain
-from agent.translate.meaning import Doubt, at_point, repeated, said_point
+from agent.translate.meaning import ASKS_NOTHING, Doubt, at_point, repeated, said_point
 from agent.translate.misheard import heard
 from agent.translate.model_path import ModelNotFoundError
 from agent.translate.names import DETERMINERS, FUNCTION_WORDS, NOT_NAMES, offered_names
@@ -277,21 +277,28 @@ class Translator:
             model = model_signal(p for s in states for p in s.probabilities)
             assessment = assess(normalized, plan, self.profile, model=model, known_objects=known)
             generating = timings["prompt"] + timings["generate"]
-            if len(states) == 1 and assessment.doubts:
-                other = (self._without_taken_back(states[0], plan, assessment, normalized, known)
-                         or self._way_as_said(states[0], plan, assessment, normalized, known)
-                         or self._point_as_said(states[0], plan, assessment, normalized, known)
-                         or self._done_again(states[0], plan, assessment, normalized, known)
-                         or self._shorter_ending(states[0], normalized, known)
-                         or self._other_choice(states[0], normalized, known, cancel, timings)
-                         or self._clause_by_clause(normalized, plan, assessment, known, cancel, timings))
-                if other is not None:
-                    program, plan, _probabilities, assessment = other
-            if back is not None:
-                program, plan = self._putting_back(program, plan, back, known)
-            guessed = self._guessed_and_doubted(states, assessment.doubts)
-            if guessed is not None:
-                attempts[-1] = Attempt(program=program, diagnostics=(guessed,))
+            # Words that asked for nothing now ("if I told you to turn left", "turn left, never mind") ask
+            # nothing of any plan: no other reading can mend them, and a question would put a motion to
+            # someone who never asked for one.
+            asked_nothing = next((d for d in assessment.doubts if d.check in ASKS_NOTHING), None)
+            if asked_nothing is not None:
+                refusal: Diagnostic | None = self._not_a_task(states[0], asked_nothing.reason)
+            else:
+                if len(states) == 1 and assessment.doubts:
+                    other = (self._without_taken_back(states[0], plan, assessment, normalized, known)
+                             or self._way_as_said(states[0], plan, assessment, normalized, known)
+                             or self._point_as_said(states[0], plan, assessment, normalized, known)
+                             or self._done_again(states[0], plan, assessment, normalized, known)
+                             or self._shorter_ending(states[0], normalized, known)
+                             or self._other_choice(states[0], normalized, known, cancel, timings)
+                             or self._clause_by_clause(normalized, plan, assessment, known, cancel, timings))
+                    if other is not None:
+                        program, plan, _probabilities, assessment = other
+                if back is not None:
+                    program, plan = self._putting_back(program, plan, back, known)
+                refusal = self._guessed_and_doubted(states, assessment.doubts)
+            if refusal is not None:
+                attempts[-1] = Attempt(program=program, diagnostics=(refusal,))
                 plan, verified = None, False
             else:
                 judged = result_fields(plan, self.profile, assessment)

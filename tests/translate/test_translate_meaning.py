@@ -462,3 +462,14 @@ def test_a_step_taken_back_is_named_by_its_place_in_the_plan(profile: Profile) -
     # One reason for the same step done twice, naming both places.
     assert len(cancelled) == 1 and cancelled[0].steps == (0, 2)
     assert all(not d.steps for d in doubts if d.check != "cancelled")
+
+
+@pytest.mark.parametrize(("task", "program"), [
+    ("look up, never mind, fetch the cup", "approach cup; grasp cup; goto 0, 0;"),
+    ("turn left, forget it, explore the room",
+     "lookleft 1.5708; perceive; lookright 3.1416; perceive; lookleft 1.5708;"),
+    ("go to the door, scrap that, back up a metre", "backward 1;"),
+])
+def test_a_step_asked_for_after_a_call_off_is_asked_for(task: str, program: str, profile: Profile) -> None:
+    """A call-off takes back what came before it; any word of a skill or whole command after it asks again."""
+    assert not [r for r in reasons(task, program, profile, ["cup"]) if "called it off" in r]

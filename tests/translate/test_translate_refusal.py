@@ -131,6 +131,22 @@ def test_a_doubted_plan_the_model_guessed_at_is_refused_as_no_task(adapted: Tran
         assert sure.doubts[0] in diagnostic.message
 
 
+@pytest.mark.parametrize(("task", "reason"), [
+    ("If I told you to turn left, would you?", "you told of an order, imagined one or planned one for later"),
+    ("Turn left... actually, never mind.", 'you called it off ("never mind")'),
+])
+def test_words_that_ask_for_nothing_now_are_refused_however_sure_the_model_is(adapted: Translator, task: str,
+                                                                              reason: str) -> None:
+    """A question about such a plan would put a motion to someone who never asked for one, so it is refused
+    with the check's reason, even where the model is sure the words are a task."""
+    engine = _FirstReadingEngine(adapted.engine, 0.99)
+    result = Translator(adapted.profile, engine, adapted.model_name,  # type: ignore[arg-type]
+                        adapted.options).translate(task)
+    assert not result.verified and result.plan is None and result.refused and result.passes == 1, result
+    (diagnostic,) = result.attempts[-1].diagnostics
+    assert diagnostic.code is Code.NOT_A_TASK and reason in diagnostic.message
+
+
 @pytest.mark.parametrize(("task", "phrase"), [
     ("Sweep the floor near the oven.", "sweep the floor"),
     ("put the cup on the table", "put the"),
