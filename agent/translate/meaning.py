@@ -219,10 +219,9 @@ def _called_off(text: str, vocab: Vocabulary) -> str:
     if last is None or not text[:last.start()].strip(" ,"):
         return ""
     after = text[last.end():]
-    # Any word of a skill or the first word of a whole command ("fetch", "explore") asks for a step.
-    asked = vocab.skill_words | {c.words[0] for c in vocab.conventions if c.whole and c.words}
-    if re.search(r"\d", after) or any(w in asked or (len(a) >= 4 and _inflected(w, a))
-                                       for w in WORD.findall(after) for a in asked):
+    asked = vocab.asking_words
+    if re.search(r"\d", after) or any(w in asked or any(len(a) >= 4 and _inflected(w, a) for a in asked)
+                                       for w in WORD.findall(after)):
         return ""
     return last.group(0)
 

@@ -40,6 +40,9 @@ class Vocabulary:
     step_words: dict[str, frozenset[str]]  # skill keyword -> the words that ask for that step
     way_skills: dict[str, frozenset[str]]  # way ("left") -> the skills that go it (turnleft, lookleft)
     base_ways: frozenset[str]  # the ways of the skills that move the robot as a whole ("left", "back")
+    # Any word of a skill and the first word of each whole command ("fetch", "explore"): a word that asks
+    # for a step.
+    asking_words: frozenset[str]
     part_verbs: frozenset[str]  # the words of parts other than the base that are no noun ("look", "tilt")
     known_words: frozenset[str]  # what a verb the profile does not list is not: its words and closed-class words
     way_and_amount: re.Pattern[str]  # a way, then a number or a convention's amount ("back a little")
@@ -205,6 +208,7 @@ def _build_vocabulary(profile: Profile) -> Vocabulary:
                        step_words=step_words, way_skills={w: frozenset(k) for w, k in way_skills.items()},
                        base_ways=frozenset(w for skill, mine, _opposite, theirs in ways
                                            if parts.get(skill, WHOLE) == WHOLE for w in mine | theirs),
+                       asking_words=skill_word_set | {c.words[0] for c in conventions if c.whole and c.words},
                        part_verbs=frozenset(w for p, ws in part_words.items() if p != WHOLE for w in ws) - set(nouns),
                        known_words=known_words,
                        way_and_amount=re.compile(rf"\s+([a-z]+)\s+(?:\d*\.?\d+|{amount_phrases})\b"),
