@@ -25,7 +25,7 @@ from dataclasses import dataclass
 from agent.corrections import MARKERS
 from agent.translate.clauses import SHAPES
 from agent.translate.explain import quantity, say
-from agent.translate.names import DETERMINERS
+from agent.translate.names import DETERMINERS, FUNCTION_WORDS, NOT_NAMES
 from agent.translate.vocabulary import NUMBER_UNIT, WHOLE, WORD, ConventionReading, Vocabulary, vocabulary
 from rsl.plan import Command, ObjectRef, Plan, Quantity
 from rsl.profile import Profile
@@ -38,8 +38,9 @@ _STEP_AFTER = re.compile(r",?\s*(?:and\s+then|and|then)\s+[a-z]")
 _CLAUSE_START = re.compile(r"(?:^|[,.;]|\b(?:and|then|so|but|or|you|to|can|could|would|will|should|must)\b)"
                            r"\s*(?=([a-z]+))")
 # What a self-correction takes back: the number or the word right before its markers ("no, make that"),
-# when another follows.
-_CORRECTED = rf"(?:,?\s+(?:{'|'.join(MARKERS)}))+,?\s+(?:the |a |an )?"
+# when another follows. A hesitation before the markers ("wait, no", "hang on, I meant") is part of them.
+_CORRECTED = (rf"(?:,?\s+(?:wait|hang on|hold on))?(?:,?\s+(?:{'|'.join(MARKERS)}))+,?\s+"
+              r"(?:(?:the|a|an) )?")
 # The number may be said again with its step ("1 m, no, back up 2 m"), in its unit or bare; a word of
 # sequence between makes the second another step.
 _TAKEN_BACK_NUMBER = re.compile(rf"(?<![\w.])(-?\d*\.?\d+)(?: (m|rad)\b)?{_CORRECTED}"
@@ -50,6 +51,10 @@ _TAKEN_BACK_WORD = re.compile(rf"\b([a-z]+){_CORRECTED}([a-z]+)")
 # back up 0.5 m").
 _CORRECTED_AMOUNT = re.compile(rf"(?<![\w.])(\d*\.?\d+) (m|rad){_CORRECTED}((?:[a-z']+,? ){{0,4}}?)(\d*\.?\d+) \2\b")
 _NEXT_WORD = re.compile(r"\s+([a-z]+)")
+_CORRECTION = re.compile(_CORRECTED)
+# A correction, or a pause alone, between a way and its opposite: "left, hang on, right", "back, I mean
+# forward", "left, scratch that, pan it right".
+_WAY_CORRECTION = re.compile(rf"(?:,?\s+(?:wait|hang on|hold on|{'|'.join(MARKERS)}))+,?\s+")
 # "would you mind turning left", "before grabbing the cup": the "-ing" word after "mind", "before" or
 # "after" asks for the act. Elsewhere an "-ing" form may tell what was done ("nice job turning left").
 _ASKED_DOING = re.compile(r"\b(mind|before|after) ([a-z]{3,}?)ing\b")
@@ -137,11 +142,26 @@ _CALLED_OFF = re.compile(r"\b(?:never ?mind|(?:forget|scrap|cancel|scratch|ignor
                          r"|not now|as you were|(?:wait|actually|no),? don'?t(?=,|$)|leave it(?=,|$))\b")
 # A check that finds the words asked for nothing now: such a plan is refused, not put to the person.
 ASKS_NOTHING = frozenset({"framed", "narrated", "question", "called-off"})
+# A check whose steps nobody asked for: a step taken back, a thing corrected to another, the robot's own
+# part taken for a thing. Leaving those steps out may leave just what was asked.
+NOT_ASKED = frozenset({"cancelled", "corrected", "corrected-way", "own-part"})
+# Words that tell where a thing is ("the keys by the front door", "the towel from the floor"), longest first.
+_WHERE = tuple(tuple(w.split()) for w in ("in front of", "on top of", "next to", "close to", "by", "beside",
+                                           "near", "behind", "under", "underneath", "on", "from", "in", "inside",
+                                           "at", "off"))
+# Words that start a clause telling more of a thing before where it is ("the charger that's plugged in by
+# the desk").
+_RELATIVE = frozenset({"that", "which", "who"})
+_PLACE_OPENERS = _OWNER | set(DETERMINERS)
 # A point's way followed by "of" says what the point lies from; only the start or the robot itself is read
 # ("1 m left of the start", "2 m in front of where you started"), not "1 m left of the table".
 _OF_START = re.compile(r" of (?:the start|your start|the starting|where you|you\b|yourself\b|it\b|here\b)")
 # A coordinate named ("x 2, y -1"): the point is said by its coordinates, not from the start.
 _COORDINATE_NAMED = re.compile(r"\b[xy]\b")
+# A noun said as the robot's own: "your gripper", "its camera"; and one said as where a thing is.
+_OWN_PART = re.compile(r"\b(?:your|its|the robot's) (?:own )?([a-z]+)")
+_PART_AS_PLACE = re.compile(r"\b(?:by|beside|near|next to|close to|in front of|behind|under|below|above|at) "
+                            r"(?:your|its|the robot's) (?:own )?(?:left |right )?([a-z]+)")
 _TOLERANCE = 0.02
 
 
@@ -190,6 +210,10 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
     doubts += _one_object(named, plan)
     doubts += _negated_done([c for c in named if c not in affirmed_named], plan, vocab)
     doubts += _objects(text, affirmed, plan, known_objects, vocab)
+    doubts += _corrected_objects(text, plan, profile)
+    doubts += _places(text, plan, profile)
+    doubts += _corrected_ways(text, plan, vocab, profile)
+    doubts += _own_parts(text, plan, vocab, profile)
     if _FRAMED.search(text):
         doubts.append(Doubt("framed", f"you told of an order, imagined one or planned one for later, but did not "
                                       f"give it, and the plan acts ({say(plan.commands[0], profile)})"))
@@ -242,13 +266,15 @@ def _words(text: str, vocab: Vocabulary) -> set[str]:
 
     A part's noun that starts a clause is a verb there ("head over to the
     table"), since the noun would need "your" or "the" before it: it asks
-    the robot as a whole to move, not the part. Words of driving right
+    the robot as a whole to move, not the part. One said as where a thing
+    is ("the cup in front of your camera") asks nothing of the part. Words of driving right
     after another part's verb say how that part moves ("look straight
     ahead"), not that the robot drives.
     """
     tokens = WORD.findall(text)
     verbs = Counter(m.group(1) for m in _CLAUSE_START.finditer(text) if m.group(1) in vocab.noun_parts)
     said = Counter(t for t, how in zip(tokens, _ways_of_parts(tokens, vocab), strict=True) if not how)
+    said -= Counter(m.group(1) for m in _PART_AS_PLACE.finditer(text))
     return ({t for t in said if verbs[t] < said[t]} | ({WHOLE} if verbs else set())
             | {a + b for a, b in itertools.pairwise(tokens) if a + b in vocab.skill_words})
 
@@ -939,9 +965,135 @@ def _objects(text: str, affirmed_text: str, plan: Plan, known: Collection[str] |
                                           f"it so, and '{acting[0]}' names a direction or an action"))
         elif not name_words <= affirmed and name_words <= denied:
             doubts.append(Doubt("negation", f"you said not the {name.replace('_', ' ')}, but the plan uses it"))
+    tokens = WORD.findall(text)
     for name in sorted(known or ()) if planned else ():
         parts = name.lower().split("_")
-        if (all(p in affirmed for p in parts) and not set(parts) & taken_back
+        # A thing said only as where another is ("the cup on the table") need not be acted on.
+        if (all(p in affirmed for p in parts) and not set(parts) & taken_back and _thing_at(tokens, parts) is None
                 and not any(set(parts) <= set(p.split("_")) for p in planned)):
             doubts.append(Doubt("object", f"you mentioned the {name.replace('_', ' ')}, but the plan never uses it"))
     return doubts
+
+
+def _corrected_objects(text: str, plan: Plan, profile: Profile) -> list[Doubt]:
+    """A thing a self-correction takes back for another ("the knife, wait, no, the ladle") is not in the
+    plan, unless it is said whole again after the correction. The plan must use the other thing too: a
+    marker word may start other talk ("the cup, no hurry"), and a word of sequence after it adds a thing
+    ("the cup, sorry, and the plate")."""
+    names = [(index, a.name.lower().split("_")) for index, c in enumerate(plan) for a in c.args
+             if isinstance(a, ObjectRef)]
+    steps: dict[str, list[int]] = {}
+    for correction in _CORRECTION.finditer(text):
+        before = WORD.findall(text[:correction.start()])
+        rest = WORD.findall(text[correction.end():])
+        if not rest or rest[0] in _SEQUENCE_WORDS:
+            continue
+        after = set(rest)
+        corrected_to = {"_".join(parts) for _, parts in names if set(parts) <= after}
+        for index, parts in names:
+            if before[-len(parts):] == parts and not set(parts) <= after and corrected_to - {"_".join(parts)}:
+                reason = (f"you took back the {' '.join(parts)}, but the plan still uses it "
+                          f"({say(plan.commands[index], profile)})")
+                steps.setdefault(reason, []).append(index)
+    return [Doubt("corrected", reason, tuple(indices)) for reason, indices in steps.items()]
+
+
+def _own_parts(text: str, plan: Plan, vocab: Vocabulary, profile: Profile) -> list[Doubt]:
+    """A part of the robot said as its own ("the pen by your gripper") is where a thing is, never a thing
+    to fetch or drive up to."""
+    owned = {m.group(1) for m in _OWN_PART.finditer(text) if m.group(1) in vocab.noun_parts}
+    steps: dict[str, list[int]] = {}
+    for index, command in enumerate(plan):
+        for name in (a.name.lower() for a in command.args if isinstance(a, ObjectRef)):
+            if name in owned:
+                steps.setdefault(f"your {name} is part of the robot, not a thing to act on, but the plan "
+                                 f"does ({say(command, profile)})", []).append(index)
+    return [Doubt("own-part", reason, tuple(indices)) for reason, indices in steps.items()]
+
+
+def things_at_places(task: str, plan: Plan) -> dict[int, str]:
+    """The plan's steps (from 0) that act on a place the task only said as where a thing is ("the keys by
+    the front door" -> `approach door;`), each with the thing's name."""
+    tokens = WORD.findall(task)
+    found: dict[int, str] = {}
+    for index, command in enumerate(plan):
+        for name in (a.name.lower() for a in command.args if isinstance(a, ObjectRef)):
+            thing = _thing_at(tokens, name.split("_"))
+            if thing is not None and thing != name:
+                found[index] = thing
+    return found
+
+
+def at_things(plan: Plan, task: str) -> str:
+    """The program of `plan` with each step on a place said only as where a thing is acting on the thing
+    instead; such a step after one on the thing already reached it, and is left out."""
+    found = things_at_places(task, plan)
+    lines = []
+    for index, command in enumerate(plan):
+        thing = found.get(index)
+        if thing is None:
+            lines.append(command.to_rsl())
+            continue
+        if any(a.name.lower() == thing for c in plan.commands[:index] for a in c.args if isinstance(a, ObjectRef)):
+            continue
+        args = tuple(ObjectRef(thing) if isinstance(a, ObjectRef) else a for a in command.args)
+        lines.append(Command(command.skill, args, command.line, command.column).to_rsl())
+    return "".join(line + "\n" for line in lines)
+
+
+def _thing_at(tokens: list[str], place: list[str]) -> str | None:
+    """The thing said right before `place` each time `place` is said as where it is; None when `place` is
+    once said otherwise, or no plain name comes before it."""
+    starts = [i for i in range(len(tokens)) if tokens[i:i + len(place)] == place]
+    things = set()
+    for start in starts:
+        # The place may be the end of a longer name ("the front door" for `door`).
+        at = next((i for i in range(start, max(-1, start - 3), -1) if i > 0 and tokens[i - 1] in _PLACE_OPENERS),
+                  None)
+        where = None if at is None else next((w for w in _WHERE if tokens[max(0, at - 1 - len(w)):at - 1] == list(w)),
+                                             None)
+        if at is None or where is None:
+            return None
+        before = tokens[max(0, at - 1 - len(where) - 6):at - 1 - len(where)]
+        opened = max((i for i, t in enumerate(before) if t in DETERMINERS and t not in _RELATIVE), default=None)
+        if opened is None:
+            return None
+        span = before[opened + 1:]
+        span = span[:next((i for i, t in enumerate(span) if t in _RELATIVE), len(span))]
+        if not 0 < len(span) <= 2 or any(w in FUNCTION_WORDS or w in NOT_NAMES or w.endswith(("ing", "ly"))
+                                         for w in span):
+            return None
+        things.add("_".join(span))
+    return things.pop() if len(things) == 1 else None
+
+
+def _places(text: str, plan: Plan, profile: Profile) -> list[Doubt]:
+    """A place said only as where a thing is ("the keys by the front door") is not what the plan acts on."""
+    steps: dict[str, list[int]] = {}
+    for index, thing in things_at_places(text, plan).items():
+        command = plan.commands[index]
+        place = next(a.name for a in command.args if isinstance(a, ObjectRef)).replace("_", " ")
+        steps.setdefault(f"the {place} only tells where to find the {thing.replace('_', ' ')}, but the plan "
+                         f"acts on it ({say(command, profile)})", []).append(index)
+    return [Doubt("place", reason, tuple(indices)) for reason, indices in steps.items()]
+
+
+def _corrected_ways(text: str, plan: Plan, vocab: Vocabulary, profile: Profile) -> list[Doubt]:
+    """A way taken back for its opposite ("turn left, hang on, right"; "pan left, scratch that, pan it
+    right") is not gone, unless it is said again after the correction."""
+    steps: dict[str, list[int]] = {}
+    for m in _WAY_CORRECTION.finditer(text):
+        before, after = WORD.findall(text[:m.start()]), WORD.findall(text[m.end():])
+        said = before[-1] if before else ""
+        meant = next((w for w in after[:3] if w in vocab.way_skills or w in _SEQUENCE_WORDS), None)
+        if said not in vocab.way_skills or meant not in vocab.way_skills or said in after:
+            continue
+        at = after.index(meant)
+        if at + 1 < len(after) and after[at + 1] in _PLACE_OR_TIME:
+            continue
+        gone = {k for k in vocab.way_skills[said] if vocab.opposites.get(k) in vocab.way_skills[meant]}
+        for index, command in enumerate(plan):
+            if command.skill in gone:
+                steps.setdefault(f"you took back \"{said}\" for \"{meant}\", but the plan still goes {said} "
+                                 f"({say(command, profile)})", []).append(index)
+    return [Doubt("corrected-way", reason, tuple(indices)) for reason, indices in steps.items()]

@@ -25,7 +25,7 @@ from agent.translate.clauses import Clause, split_clauses
 from agent.translate.confidence import Assessment, assess, model_signal, result_fields, with_doubt
 from agent.translate.engine import FORK_RECORD_FLOOR, CancelFlag, Fork, Generation
 from agent.translate.explain import explain
-from agent.translate.meaning import ASKS_NOTHING, Doubt, at_point, repeated, said_point
+from agent.translate.meaning import ASKS_NOTHING, NOT_ASKED, Doubt, at_point, at_things, repeated, said_point
 from agent.translate.misheard import heard
 from agent.translate.model_path import ModelNotFoundError
 from agent.translate.names import DETERMINERS, FUNCTION_WORDS, NOT_NAMES, offered_names
@@ -286,6 +286,7 @@ class Translator:
             else:
                 if len(states) == 1 and assessment.doubts:
                     other = (self._without_taken_back(states[0], plan, assessment, normalized, known)
+                             or self._at_the_thing(states[0], plan, assessment, normalized, known)
                              or self._way_as_said(states[0], plan, assessment, normalized, known)
                              or self._point_as_said(states[0], plan, assessment, normalized, known)
                              or self._done_again(states[0], plan, assessment, normalized, known)
@@ -328,21 +329,35 @@ class Translator:
 
     def _without_taken_back(self, state: _ClauseState, plan: Plan, judged: Assessment, normalized: str,
                             known: Collection[str] | None) -> _Candidate | None:
-        """The plan without the steps the person took back, where the checks found them still in it and
-        pass the rest.
+        """The plan without the steps nobody asked for, where the checks found them in it and pass the rest.
 
-        "Drive forward 4 m and turn left, actually skip the turn" comes out with the turn: the model reads
-        the take-back as words, not as an edit. The check that doubts it knows which steps were taken
-        back, so leaving them out costs no generation. What is left passes every check and is only what
+        "Drive forward 4 m and turn left, actually skip the turn" comes out with the turn, and "the knife,
+        wait, no, the ladle" with both: the model reads a take-back as words, not as an edit. "The pen by
+        your gripper, pick it up" also picks up the gripper. The check that doubts such steps knows which
+        they are, so leaving them out costs no generation. What is left passes every check and is only what
         the person asked for, so it is judged as any such plan is, on the model's own signal.
         """
-        dropped = {i for d in judged.doubts if d.check == "cancelled" for i in d.steps}
+        dropped = {i for d in judged.doubts if d.check in NOT_ASKED for i in d.steps}
         if not dropped:
             return None
         kept = "".join(c.to_rsl() + "\n" for i, c in enumerate(plan) if i not in dropped)
         said = explain(Plan(tuple(c for i, c in enumerate(plan) if i in dropped), plan.profile), self.profile)
         return self._mend_passing(kept, state, normalized, known, f"the plan still did what the task took back "
                                                                   f"({said}); left out")
+
+    def _at_the_thing(self, state: _ClauseState, plan: Plan, judged: Assessment, normalized: str,
+                      known: Collection[str] | None) -> _Candidate | None:
+        """The plan acting on the things the task named where it acted on the places said only as where
+        they are, where the rest passes the checks.
+
+        "Head over to the keys by the front door" often comes out as `approach door;`: a small model
+        takes the last thing said. The check knows the steps and the thing, so mending them costs no
+        generation, and the plan is judged on the model's own signal, as the other mends' are.
+        """
+        if not any(d.check == "place" for d in judged.doubts):
+            return None
+        return self._mend_passing(at_things(plan, normalized), state, normalized, known,
+                                  "the plan acted on a place said only as where a thing is; set to the thing")
 
     def _way_as_said(self, state: _ClauseState, plan: Plan, judged: Assessment, normalized: str,
                      known: Collection[str] | None) -> _Candidate | None:

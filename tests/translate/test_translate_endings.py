@@ -249,6 +249,16 @@ def test_what_is_left_after_the_take_back_must_pass_the_checks_too(translator: T
 @pytest.mark.parametrize(("mend", "task", "program", "mended"), [
     ("_without_taken_back", "Drive forward four metres and turn left, actually skip the turn.",
      "forward 4;\nturnleft 1.5708;\n", "forward 4;\n"),
+    ("_without_taken_back", "Pick up the knife, wait, no, the ladle.", "grasp ladle;\ngrasp knife;\n",
+     "grasp ladle;\n"),
+    ("_without_taken_back", "Turn left, no, right, thirty degrees.", "turnright 0.5236;\nturnleft 1.5708;\n",
+     "turnright 0.5236;\n"),
+    ("_without_taken_back", "The sponge is right by your gripper, grab it.", "grasp sponge;\ngrasp gripper;\n",
+     "grasp sponge;\n"),
+    ("_at_the_thing", "Go get the newspaper from the porch.", "approach porch;\ngrasp newspaper;\ngoto 0, 0;\n",
+     "approach newspaper;\ngrasp newspaper;\ngoto 0, 0;\n"),
+    # A step on the place after one on the thing is left out: the thing was already reached.
+    ("_at_the_thing", "Pick up the banana next to the sink.", "grasp banana;\napproach sink;\n", "grasp banana;\n"),
     ("_way_as_said", "Spin in a full circle, then grab the cup.", "turnright 6.2832;\ngrasp cup;\n",
      "turnleft 6.2832;\ngrasp cup;\n"),
     ("_point_as_said", "Go to a point one metre to your right and two metres forward.", "goto 1, 2;\nforward 2;\n",
@@ -268,6 +278,7 @@ def test_a_mend_writes_what_its_doubt_names_and_judges_it_on_the_model(
 
 @pytest.mark.parametrize(("mend", "task", "program"), [
     ("_way_as_said", "turn right in a full circle", "turnright 6.2832;\n"),
+    ("_at_the_thing", "go to the table by the window and grab the cup", "approach table;\ngrasp cup;\n"),
     ("_point_as_said", "go to x 1, y 2", "goto 2, 1;\n"),
     # "again" inside a step asks for that step, not for everything before it once more.
     ("_done_again", "go forward 2 metres, then turn left again", "forward 2;\nturnleft 1.5708;\n"),

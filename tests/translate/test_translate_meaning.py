@@ -268,6 +268,22 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
     ("I wish you could turn around faster", "turnleft 3.1416;",
      "you told of an order, imagined one or planned one for later, but did not give it, and the plan acts "
      "(turn left 180°)"),
+    # A thing taken back for another is not used; a hesitation before the marker is part of the correction.
+    ("pick up the knife, wait, no, the ladle", "grasp ladle; grasp knife;",
+     "you took back the knife, but the plan still uses it (pick up the knife)"),
+    ("grab the red mug. Hang on, I meant the green mug", "grasp green_mug; grasp red_mug;",
+     "you took back the red mug, but the plan still uses it (pick up the red mug)"),
+    # A way taken back for its opposite, by a correction or a pause alone.
+    ("turn left, hang on, right, thirty degrees", "turnright 0.5236; turnleft 1.5708;",
+     'you took back "left" for "right", but the plan still goes left (turn left 90°)'),
+    # The robot's own part tells where a thing is; it is no thing to act on.
+    ("the sponge is right by your gripper, grab it", "grasp sponge; grasp gripper;",
+     "your gripper is part of the robot, not a thing to act on, but the plan does (pick up the gripper)"),
+    # A place said only as where a thing is, the end of a longer name or after more said of the thing.
+    ("head over to the keys by the front door", "approach door;",
+     "the door only tells where to find the keys, but the plan acts on it (drive up to the door)"),
+    ("bring me the charger that's plugged in by the desk", "approach desk; grasp desk; goto 0, 0;",
+     "the desk only tells where to find the charger, but the plan acts on it (drive up to the desk)"),
 ])
 def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str, expected: str,
                                                          profile: Profile) -> None:
@@ -426,6 +442,22 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     ("forget it, go forward 2 metres", "forward 2;"),
     ("turn left, never mind, turn right", "turnright 1.5708;"),
     ("when you turned left, go forward 2 metres", "turnleft 1.5708; forward 2;"),
+    # A marker word that starts other talk, or is followed by another thing, takes nothing back; neither
+    # does a thing said whole again.
+    ("grab the cup, no rush", "grasp cup;"),
+    ("grab the cup, sorry, and the plate too", "grasp cup; grasp plate;"),
+    ("pick up the box, no, the other box", "grasp box;"),
+    ("pick up the cup, wait, no, the cup on the left", "grasp cup;"),
+    # A way said again after the correction is asked for; "right away" is no way.
+    ("turn left, no, right and then left again", "turnright 1.5708; turnleft 1.5708;"),
+    ("turn left, sorry, right away please", "turnleft 1.5708;"),
+    # A thing by the robot's part, and a part that is no part of the robot.
+    ("pick up the cup in front of your camera", "grasp cup;"),
+    ("drive up to the charging base", "approach charging_base;"),
+    # A place said as where to go, or where a thing is that the plan acts on.
+    ("go to the table by the window and grab the cup", "approach table; grasp cup;"),
+    ("grab the cup from the table, then go to the table", "grasp cup; approach table;"),
+    ("pick up the cup on the table", "grasp cup;"),
 ])
 def test_a_plan_that_does_what_was_said_has_no_doubt(task: str, program: str, profile: Profile) -> None:
     assert reasons(task, program, profile, ["cup", "table", "keys"]) == []
