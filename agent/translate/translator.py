@@ -25,7 +25,8 @@ from agent.translate.clauses import Clause, split_clauses
 from agent.translate.confidence import Assessment, assess, model_signal, result_fields, with_doubt
 from agent.translate.engine import FORK_RECORD_FLOOR, CancelFlag, Fork, Generation
 from agent.translate.explain import explain
-from agent.translate.meaning import ASKS_NOTHING, NOT_ASKED, Doubt, at_point, at_things, repeated, said_point
+from agent.translate.meaning import ASKS_NOTHING, Doubt
+from agent.translate.mends import MENDS, Mend
 from agent.translate.misheard import heard
 from agent.translate.model_path import ModelNotFoundError
 from agent.translate.names import DETERMINERS, FUNCTION_WORDS, NOT_NAMES, offered_names
@@ -40,10 +41,10 @@ from agent.translate.prompt import (
     system_text,
 )
 from agent.translate.result import Attempt, TranslationResult
-from agent.translate.vocabulary import skill_words, vocabulary
+from agent.translate.vocabulary import skill_words
 from rsl.compiler import compile_program
 from rsl.diagnostics import Code, Diagnostic
-from rsl.plan import Command, Plan, Quantity, format_number
+from rsl.plan import Plan, Quantity, format_number
 from rsl.profile import IDENTIFIER, Convention, Profile
 from rsl.syntax import NO_PROGRAM
 
@@ -285,11 +286,7 @@ class Translator:
                 refusal: Diagnostic | None = self._not_a_task(states[0], asked_nothing.reason)
             else:
                 if len(states) == 1 and assessment.doubts:
-                    other = (self._without_taken_back(states[0], plan, assessment, normalized, known)
-                             or self._at_the_thing(states[0], plan, assessment, normalized, known)
-                             or self._way_as_said(states[0], plan, assessment, normalized, known)
-                             or self._point_as_said(states[0], plan, assessment, normalized, known)
-                             or self._done_again(states[0], plan, assessment, normalized, known)
+                    other = (self._mended(states[0], plan, assessment, normalized, known)
                              or self._shorter_ending(states[0], normalized, known)
                              or self._other_choice(states[0], normalized, known, cancel, timings)
                              or self._clause_by_clause(normalized, plan, assessment, known, cancel, timings))
@@ -327,96 +324,23 @@ class Translator:
         progress.debug("putting the %s back: %r", back.part, steps.strip())
         return program + steps, whole.plan
 
-    def _without_taken_back(self, state: _ClauseState, plan: Plan, judged: Assessment, normalized: str,
-                            known: Collection[str] | None) -> _Candidate | None:
-        """The plan without the steps nobody asked for, where the checks found them in it and pass the rest.
+    def _mended(self, state: _ClauseState, plan: Plan, judged: Assessment, normalized: str,
+                known: Collection[str] | None) -> _Candidate | None:
+        """The first program a mend (agent/translate/mends.py) writes of a doubted plan that passes every
+        check, judged on the first reading's own signal; None when none does."""
+        for mend in MENDS:
+            passing = self._mend(mend, state, plan, judged, normalized, known)
+            if passing is not None:
+                return passing
+        return None
 
-        "Drive forward 4 m and turn left, actually skip the turn" comes out with the turn, and "the knife,
-        wait, no, the ladle" with both: the model reads a take-back as words, not as an edit. "The pen by
-        your gripper, pick it up" also picks up the gripper. The check that doubts such steps knows which
-        they are, so leaving them out costs no generation. What is left passes every check and is only what
-        the person asked for, so it is judged as any such plan is, on the model's own signal.
-        """
-        dropped = {i for d in judged.doubts if d.check in NOT_ASKED for i in d.steps}
-        if not dropped:
-            return None
-        kept = "".join(c.to_rsl() + "\n" for i, c in enumerate(plan) if i not in dropped)
-        said = explain(Plan(tuple(c for i, c in enumerate(plan) if i in dropped), plan.profile), self.profile)
-        return self._mend_passing(kept, state, normalized, known, f"the plan still did what the task took back "
-                                                                  f"({said}); left out")
-
-    def _at_the_thing(self, state: _ClauseState, plan: Plan, judged: Assessment, normalized: str,
-                      known: Collection[str] | None) -> _Candidate | None:
-        """The plan acting on the things the task named where it acted on the places said only as where
-        they are, where the rest passes the checks.
-
-        "Head over to the keys by the front door" often comes out as `approach door;`: a small model
-        takes the last thing said. The check knows the steps and the thing, so mending them costs no
-        generation, and the plan is judged on the model's own signal, as the other mends' are.
-        """
-        if not any(d.check == "place" for d in judged.doubts):
-            return None
-        return self._mend_passing(at_things(plan, normalized), state, normalized, known,
-                                  "the plan acted on a place said only as where a thing is; set to the thing")
-
-    def _way_as_said(self, state: _ClauseState, plan: Plan, judged: Assessment, normalized: str,
-                     known: Collection[str] | None) -> _Candidate | None:
-        """The plan with the steps that went the other way than the profile's convention turned its way,
-        where the task said no way and the rest passes the checks.
-
-        "Spin in a full circle" means what its convention's example does; the model sometimes turns the
-        other way by the same amount. The check knows which steps, so turning them costs no generation, and
-        the plan is judged on the model's own signal, as the take-back mend's is.
-        """
-        turned = {i for d in judged.doubts if d.check == "unsaid way" for i in d.steps}
-        if not turned:
-            return None
-        opposites = vocabulary(self.profile).opposites
-        mended = "".join((Command(opposites[c.skill], c.args, c.line, c.column) if i in turned else c).to_rsl()
-                         + "\n" for i, c in enumerate(plan))
-        return self._mend_passing(mended, state, normalized, known,
-                                  "the plan went the other way than the task's convention; turned")
-
-    def _point_as_said(self, state: _ClauseState, plan: Plan, judged: Assessment, normalized: str,
-                       known: Collection[str] | None) -> _Candidate | None:
-        """The plan driving to the point the task said from the start, without the steps that drove that
-        point's amounts again, where the rest passes the checks.
-
-        "The spot 2 m ahead and 1 m to your right" is exact once the profile's frame reads it; the model
-        often swaps the axes or loses a sign. The check knows the steps, so mending them costs no
-        generation, and the plan is judged on the model's own signal, as the other mends' are.
-        """
-        steps = next((d.steps for d in judged.doubts if d.check == "point"), ())
-        point = said_point(normalized, self.profile) if steps else None
-        meant = at_point(plan.commands[steps[0]], point, self.profile) if steps and point else None
-        if meant is None:
-            return None
-        mended = "".join((meant if i == steps[0] else c).to_rsl() + "\n" for i, c in enumerate(plan)
-                         if i not in steps[1:])
-        return self._mend_passing(mended, state, normalized, known,
-                                  "the plan drove elsewhere than the point said from the start; set to it")
-
-    def _done_again(self, state: _ClauseState, plan: Plan, judged: Assessment, normalized: str,
-                    known: Collection[str] | None) -> _Candidate | None:
-        """The plan done again as many times as the task's end asks ("..., and repeat that once more"), where
-        the checks found it done once and the repeats pass them.
-
-        The model reads "do that again" as words and writes the steps once; what "that" is, everything said
-        before, is the plan itself, so repeating it costs no generation. It is judged on the model's own
-        signal, as the other mends are.
-        """
-        if not any(d.check == "again" for d in judged.doubts):
-            return None
-        return self._mend_passing(repeated(plan, normalized, self.profile), state, normalized, known,
-                                  "the task asked for its steps again and the plan did them once; repeated")
-
-    def _mend_passing(self, mended: str, state: _ClauseState, normalized: str, known: Collection[str] | None,
-                      what: str) -> _Candidate | None:
-        """`mended`, the program a mend made of a doubted plan without generating, when it passes every
-        check; it is judged on the first reading's own signal. `what` says what was mended, for -v."""
-        passing = self._passing(mended, state.probabilities, normalized, known)
+    def _mend(self, mend: Mend, state: _ClauseState, plan: Plan, judged: Assessment, normalized: str,
+              known: Collection[str] | None) -> _Candidate | None:
+        """What `mend` writes of `plan`, when its doubts name what it mends and the result passes every check."""
+        written = mend.write(plan, judged.doubts, normalized, self.profile)
+        passing = None if written is None else self._passing(written, state.probabilities, normalized, known)
         if passing is not None:
-            progress.debug("%s, it passes the checks", what)
+            progress.debug("%s, it passes the checks", mend.what)
         return passing
 
     def _shorter_ending(self, state: _ClauseState, normalized: str, known: Collection[str] | None

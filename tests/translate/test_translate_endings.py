@@ -3,7 +3,6 @@ whole program fails a meaning check."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from typing import Any
 
 import pytest
@@ -14,6 +13,7 @@ from agent.translate.automaton import RslAutomaton
 from agent.translate.clauses import Clause
 from agent.translate.confidence import UNSURE_BELOW, Assessment, assess
 from agent.translate.engine import Fork
+from agent.translate.mends import MENDS
 from agent.translate.translator import ENDING_FLOOR, FORK_FLOOR, _ClauseState, _end_where_weighed
 from rsl.compiler import compile_program
 from rsl.plan import Plan
@@ -225,17 +225,18 @@ def _whole_state(task: str, program: str) -> _ClauseState:
     return state
 
 
-def _mended(mend: Callable[..., Any], translator: Translator, task: str, program: str) -> Any:
-    """What `mend` (a translator method that mends a doubted whole reading) makes of `program` read whole."""
+def _mended(mend: str, translator: Translator, task: str, program: str) -> Any:
+    """What the mend named `mend` makes of `program` read whole, when that passes the checks."""
     normalized, plan, judged = _read_whole(translator, task, program)
-    return mend(_whole_state(task, program), plan, judged, normalized, None)
+    chosen = next(m for m in MENDS if m.name == mend)
+    return translator._mend(chosen, _whole_state(task, program), plan, judged, normalized, None)
 
 
 def test_nothing_is_left_out_of_a_plan_no_take_back_doubts(translator: Translator) -> None:
     task = "turn around to the right"
     _normalized, _plan, judged = _read_whole(translator, task, "turnleft 3.1416;\n")
     assert judged.doubts
-    assert _mended(translator._without_taken_back, translator, task, "turnleft 3.1416;\n") is None
+    assert _mended("left out", translator, task, "turnleft 3.1416;\n") is None
 
 
 def test_what_is_left_after_the_take_back_must_pass_the_checks_too(translator: Translator) -> None:
@@ -243,32 +244,32 @@ def test_what_is_left_after_the_take_back_must_pass_the_checks_too(translator: T
     task = "Move forward one metre, then look down. Actually, skip moving, just look down."
     _normalized, _plan, judged = _read_whole(translator, task, "forward 1;\nlookdown 0.5236;\n")
     assert any(d.check == "cancelled" for d in judged.doubts)
-    assert _mended(translator._without_taken_back, translator, task, "forward 1;\nlookdown 0.5236;\n") is None
+    assert _mended("left out", translator, task, "forward 1;\nlookdown 0.5236;\n") is None
 
 
 @pytest.mark.parametrize(("mend", "task", "program", "mended"), [
-    ("_without_taken_back", "Drive forward four metres and turn left, actually skip the turn.",
+    ("left out", "Drive forward four metres and turn left, actually skip the turn.",
      "forward 4;\nturnleft 1.5708;\n", "forward 4;\n"),
-    ("_without_taken_back", "Pick up the knife, wait, no, the ladle.", "grasp ladle;\ngrasp knife;\n",
+    ("left out", "Pick up the knife, wait, no, the ladle.", "grasp ladle;\ngrasp knife;\n",
      "grasp ladle;\n"),
-    ("_without_taken_back", "Turn left, no, right, thirty degrees.", "turnright 0.5236;\nturnleft 1.5708;\n",
+    ("left out", "Turn left, no, right, thirty degrees.", "turnright 0.5236;\nturnleft 1.5708;\n",
      "turnright 0.5236;\n"),
-    ("_without_taken_back", "The sponge is right by your gripper, grab it.", "grasp sponge;\ngrasp gripper;\n",
+    ("left out", "The sponge is right by your gripper, grab it.", "grasp sponge;\ngrasp gripper;\n",
      "grasp sponge;\n"),
-    ("_at_the_thing", "Go get the newspaper from the porch.", "approach porch;\ngrasp newspaper;\ngoto 0, 0;\n",
+    ("at the thing", "Go get the newspaper from the porch.", "approach porch;\ngrasp newspaper;\ngoto 0, 0;\n",
      "approach newspaper;\ngrasp newspaper;\ngoto 0, 0;\n"),
     # A step on the place after one on the thing is left out: the thing was already reached.
-    ("_at_the_thing", "Pick up the banana next to the sink.", "grasp banana;\napproach sink;\n", "grasp banana;\n"),
-    ("_way_as_said", "Spin in a full circle, then grab the cup.", "turnright 6.2832;\ngrasp cup;\n",
+    ("at the thing", "Pick up the banana next to the sink.", "grasp banana;\napproach sink;\n", "grasp banana;\n"),
+    ("way as said", "Spin in a full circle, then grab the cup.", "turnright 6.2832;\ngrasp cup;\n",
      "turnleft 6.2832;\ngrasp cup;\n"),
-    ("_point_as_said", "Go to a point one metre to your right and two metres forward.", "goto 1, 2;\nforward 2;\n",
+    ("point as said", "Go to a point one metre to your right and two metres forward.", "goto 1, 2;\nforward 2;\n",
      "goto 2, -1;\n"),
-    ("_done_again", "Rotate left 30 degrees and move forward 2 meters, and repeat that once more.",
+    ("done again", "Rotate left 30 degrees and move forward 2 meters, and repeat that once more.",
      "turnleft 0.5236;\nforward 2;\n", "turnleft 0.5236;\nforward 2;\nturnleft 0.5236;\nforward 2;\n"),
 ])
 def test_a_mend_writes_what_its_doubt_names_and_judges_it_on_the_model(
         translator: Translator, mend: str, task: str, program: str, mended: str) -> None:
-    found = _mended(getattr(translator, mend), translator, task, program)
+    found = _mended(mend, translator, task, program)
     assert found is not None
     written, plan, probabilities, assessment = found
     assert written == mended and len(plan) == mended.count(";") and probabilities == (0.9, 0.95)
@@ -277,15 +278,15 @@ def test_a_mend_writes_what_its_doubt_names_and_judges_it_on_the_model(
 
 
 @pytest.mark.parametrize(("mend", "task", "program"), [
-    ("_way_as_said", "turn right in a full circle", "turnright 6.2832;\n"),
-    ("_at_the_thing", "go to the table by the window and grab the cup", "approach table;\ngrasp cup;\n"),
-    ("_point_as_said", "go to x 1, y 2", "goto 2, 1;\n"),
+    ("way as said", "turn right in a full circle", "turnright 6.2832;\n"),
+    ("at the thing", "go to the table by the window and grab the cup", "approach table;\ngrasp cup;\n"),
+    ("point as said", "go to x 1, y 2", "goto 2, 1;\n"),
     # "again" inside a step asks for that step, not for everything before it once more.
-    ("_done_again", "go forward 2 metres, then turn left again", "forward 2;\nturnleft 1.5708;\n"),
+    ("done again", "go forward 2 metres, then turn left again", "forward 2;\nturnleft 1.5708;\n"),
 ])
 def test_a_mend_keeps_a_plan_its_doubt_does_not_name(translator: Translator, mend: str, task: str,
                                                      program: str) -> None:
-    assert _mended(getattr(translator, mend), translator, task, program) is None
+    assert _mended(mend, translator, task, program) is None
 
 
 def test_a_clause_that_reads_as_no_task_gives_no_step_of_the_clause_by_clause_reading(adapted: Translator) -> None:
