@@ -24,14 +24,14 @@ from rsl.plan import format_number
 
 _TOKEN = re.compile(r"\d*\.\d+|\d+|[a-z]+(?:'[a-z]+)?|°|,|[.!?;:]")
 
-_ONES = {
+ONES = {
     "zero": 0, "nought": 0, "naught": 0, "oh": 0, "one": 1, "two": 2, "three": 3, "four": 4, "five": 5,
     "six": 6, "seven": 7, "eight": 8, "nine": 9, "ten": 10, "eleven": 11, "twelve": 12, "thirteen": 13, "fourteen": 14,
     "fifteen": 15, "sixteen": 16, "seventeen": 17, "eighteen": 18, "nineteen": 19,
 }
 _TENS = {"twenty": 20, "thirty": 30, "forty": 40, "fifty": 50, "sixty": 60, "seventy": 70,
          "eighty": 80, "ninety": 90}
-_DIGIT_WORDS = {**{w: v for w, v in _ONES.items() if v < 10}, "o": 0}
+_DIGIT_WORDS = {**{w: v for w, v in ONES.items() if v < 10}, "o": 0}
 _FRACTIONS = {"half": 0.5, "quarter": 0.25, "third": 1 / 3}
 # The parts a whole is cut into: "a third", "three quarters", "two fifths".
 _DENOMINATORS = {
@@ -43,7 +43,7 @@ _DENOMINATORS = {
 
 # Words an ASR writes for a number word; only read as numbers when a unit or
 # `times` follows, so "go to the door" and "look for the cup" are untouched.
-_HOMOPHONES = {"to": 2, "too": 2, "for": 4, "fore": 4, "won": 1, "ate": 8, "tree": 3, "free": 3}
+NUMBER_HOMOPHONES = {"to": 2, "too": 2, "for": 4, "fore": 4, "won": 1, "ate": 8, "tree": 3, "free": 3}
 
 _LENGTHS = {
     **dict.fromkeys(("m", "meter", "meters", "metre", "metres", "mtr", "mtrs"), 1.0),
@@ -156,7 +156,7 @@ def _join_split_numbers(tokens: list[str]) -> list[str]:
             joined = out[-1] + token
             if out[-1] in _FOUR_HEARD_AS:
                 joined = "forty" if token == "ty" else "fourteen"
-            if joined in _TENS or joined in _ONES:
+            if joined in _TENS or joined in ONES:
                 out[-1] = joined
                 continue
         out.append(token)
@@ -288,9 +288,9 @@ def _parse_integer_words(tokens: Sequence[str], i: int) -> tuple[float, int] | N
         if word in ("a", "an") and j == i and tokens[j + 1:j + 2] in (["hundred"], ["thousand"]):
             # "a hundred and eighty degrees" is one number; read from "hundred" on, it would be eighty.
             value, last = 1, "ones"
-        elif word in _ONES and word != "oh" and (
-                last in ("", "hundred", "thousand", "and") or (last == "tens" and _ONES[word] < 10)):
-            value, last = value + _ONES[word], "ones"
+        elif word in ONES and word != "oh" and (
+                last in ("", "hundred", "thousand", "and") or (last == "tens" and ONES[word] < 10)):
+            value, last = value + ONES[word], "ones"
         elif word in _TENS and last in ("", "hundred", "thousand", "and"):
             value, last = value + _TENS[word], "tens"
         elif word in _TENS and last == "ones" and j == i + 1 and value < 10:
@@ -303,7 +303,7 @@ def _parse_integer_words(tokens: Sequence[str], i: int) -> tuple[float, int] | N
         elif word == "thousand" and last in ("ones", "tens", "hundred") and value < 1000:
             value, last = value * 1000, "thousand"
         elif (word == "and" and last in ("hundred", "thousand") and j + 1 < len(tokens)
-              and (tokens[j + 1] in _ONES or tokens[j + 1] in _TENS)):
+              and (tokens[j + 1] in ONES or tokens[j + 1] in _TENS)):
             last = "and"
         else:
             break
@@ -459,9 +459,9 @@ def _in_point(tokens: Sequence[str], i: int) -> bool:
     word that names one: "the point for comma one", "go to two, for". A recognizer spells a number that way
     wherever one is said, not only before a unit; "look for, 2 cups" and "go to 1, for the cup" stay words."""
     def number_at(k: int) -> bool:
-        return 0 <= k < len(tokens) and (tokens[k] in _HOMOPHONES or _parse_number(tokens, k) is not None)
+        return 0 <= k < len(tokens) and (tokens[k] in NUMBER_HOMOPHONES or _parse_number(tokens, k) is not None)
 
-    if i >= len(tokens) or tokens[i] not in _HOMOPHONES:
+    if i >= len(tokens) or tokens[i] not in NUMBER_HOMOPHONES:
         return False
     comma = (",", "comma")
     first = (i >= 1 and tokens[i - 1] in _POINT_WORDS and i + 2 < len(tokens) and tokens[i + 1] in comma
@@ -501,16 +501,16 @@ def _convert_at(tokens: list[str], i: int) -> tuple[str, int] | None:
         if _bare_degrees(tokens, i, value, j):
             return f"{format_number(math.radians(value))} rad", j
         return format_number(value), j
-    if token in _HOMOPHONES:
+    if token in NUMBER_HOMOPHONES:
         nxt = tokens[i + 1] if i + 1 < len(tokens) else ""
         if _in_point(tokens, i):
-            return format_number(_HOMOPHONES[token]), i + 1
+            return format_number(NUMBER_HOMOPHONES[token]), i + 1
         if nxt == "times" or _unit_at(tokens, i + 1) is not None or _revolutions_at(tokens, i + 1):
-            value = float(_HOMOPHONES[token])
+            value = float(NUMBER_HOMOPHONES[token])
             unit = _with_unit(tokens, value, i + 1, explicit=True)
             return unit if unit is not None else (format_number(value), i + 1)
         if tokens[i + 1:i + 4] == ["and", "a", "half"] and _unit_at(tokens, i + 4) is not None:
-            unit = _with_unit(tokens, _HOMOPHONES[token] + 0.5, i + 4, explicit=True)
+            unit = _with_unit(tokens, NUMBER_HOMOPHONES[token] + 0.5, i + 4, explicit=True)
             if unit is not None:
                 return unit
     fraction = _fraction_phrase(tokens, i)

@@ -14,7 +14,7 @@ import re
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
-from agent.normalize import _ANGLES, _FILLERS, _FRACTIONS, _LENGTHS, _ONES, _REVOLUTIONS, _TENS
+from agent.normalize import _ANGLES, _FILLERS, _FRACTIONS, _LENGTHS, _REVOLUTIONS, _TENS, ONES
 
 
 @dataclass(frozen=True)
@@ -43,7 +43,7 @@ def _alphabetic(words: Iterable[str]) -> tuple[str, ...]:
 
 ENGLISH = Lexicon(
     language="en",
-    numbers=_alphabetic({*_ONES, *_TENS, *_FRACTIONS, "hundred", "point", "a", "an"}),
+    numbers=_alphabetic({*ONES, *_TENS, *_FRACTIONS, "hundred", "point", "a", "an"}),
     units=_alphabetic({*_LENGTHS, *_ANGLES, *_REVOLUTIONS, "times", "twice", "once", "full", "half"}),
     connectives=(
         "then", "and", "after", "that", "next", "finally", "first", "it", "them", "the", "a", "to", "of",

@@ -15,11 +15,20 @@ leaves ("write" after "you", where it may be the verb).
 A recognizer also writes a word of the robot's in two ("drive for ward",
 "a lit tle"): two words are joined where together they are a word of the
 profile's skills or conventions and the second alone is none of its words.
+
+It writes numbers as other words too. The normalizer reads "for" as four
+before a unit and in a point said with a comma; a point said without one
+("the point for too", "x for y too", "position for 3", "3 and for") is read
+back here, and so are tens and hundreds heard as a homophone and a syllable
+("for tee five degrees", "won hundred twenty"), before the normalizer reads
+the number.
 """
 
 from __future__ import annotations
 
-from agent.normalize import normalize_task
+import re
+
+from agent.normalize import NUMBER_HOMOPHONES, ONES, normalize_task
 from agent.translate.vocabulary import Vocabulary, vocabulary
 from rsl.profile import Profile
 
@@ -38,10 +47,33 @@ _HEARD_FOR_COLOUR = {"read": "red", "blew": "blue"}
 _DETERMINERS = frozenset({"the", "a", "an", "your", "my", "that", "this"})
 
 
+# Tens heard as a word and "tee" before a number's ones or "degrees" ("for tee five", "fif tee degrees"; not
+# "look for tee shirts"), and a hundred's count heard as a homophone ("won hundred").
+_TENS_HEARD = re.compile(r"\b(for|fore|fif|six|seven|ate|nine|thir|twen) tee (?=("
+                         + "|".join(w for w, v in ONES.items() if 0 < v < 10) + "|" + "|".join(NUMBER_HOMOPHONES)
+                         + r"|degrees?)\b)")
+_TENS = {"for": "forty", "fore": "forty", "fif": "fifty", "six": "sixty", "seven": "seventy", "ate": "eighty",
+         "nine": "ninety", "thir": "thirty", "twen": "twenty"}
+_TENS_UNITS = r"(?:degrees?|centimet(?:er|re)s?|cm)"
+_HUNDREDS_HEARD = re.compile(r"\b(won|too|for|fore|tree|free|ate) (hundred|thousand)\b")
+_COUNTS = {heard: next(word for word, value in ONES.items() if value == number)
+           for heard, number in NUMBER_HOMOPHONES.items()}
+# Words that name a point right before its two coordinates ("the point for too"); "x" names the first of
+# "x for y too".
+_POINT_WORDS = frozenset({"point", "position", "coordinates", "coordinate", "location", "spot"})
+_BETWEEN_COORDINATES = frozenset({",", "and", "comma"})
+
+
 def heard(task: str, profile: Profile) -> str:
     """The task as the model and the checks read it: normalized, with mishearings read back."""
+    said = _TENS_HEARD.sub(lambda m: _TENS[m.group(1)] + " ", task.lower())
+    # The ones after tens may be a homophone too ("for tee for degrees"); only before the units tens are
+    # said in, so "twenty to the door" keeps its "to".
+    said = re.sub(rf"\b({'|'.join(_TENS.values())}) ({'|'.join(NUMBER_HOMOPHONES)})(?= {_TENS_UNITS}\b)",
+                  lambda m: f"{m.group(1)} {_COUNTS[m.group(2)]}", said)
+    said = _HUNDREDS_HEARD.sub(lambda m: f"{_COUNTS[m.group(1)]} {m.group(2)}", said)
     # The normalizer writes a clause comma right after its word ("turn write, then").
-    words = _joined(normalize_task(task).replace(",", " ,").split(), vocabulary(profile))
+    words = _points(_joined(normalize_task(said).replace(",", " ,").split(), vocabulary(profile)))
     out = []
     for i, word in enumerate(words):
         before, after = words[i - 1] if i else "", words[i + 1:i + 3]
@@ -77,3 +109,37 @@ def _not_the_verb(before: str, after: list[str]) -> bool:
 
 def _is_number(word: str) -> bool:
     return word.replace(".", "", 1).isdigit()
+
+
+def _points(words: list[str]) -> list[str]:
+    """`words` with a point's coordinates heard as homophones read as numbers: "point for too" is "point 4,
+    2", "x for y too" is "x 4 y 2". Both coordinates must be numbers or homophones, one a homophone."""
+    out = list(words)
+    for i, word in enumerate(words):
+        pair = words[i + 1:i + 4]
+        if word == "x" and len(pair) == 3 and pair[1] == "y":
+            first, second = pair[0], pair[2]
+        elif word in _POINT_WORDS and len(pair) >= 2:
+            with_between = len(pair) == 3 and pair[1] in _BETWEEN_COORDINATES
+            first, second = pair[0], pair[2] if with_between else pair[1]
+        else:
+            continue
+        if not (_coordinate(first) and _coordinate(second) and {first, second} & NUMBER_HOMOPHONES.keys()):
+            continue
+        gap = 1 if second is pair[1] and word != "x" else 2
+        out[i + 1] = _digit(first)
+        out[i + 1 + gap] = _digit(second)
+        if word != "x":
+            # Said whole, a point is two numbers joined by a comma, as the normalizer writes "3 comma 2".
+            out[i + 1] += ","
+            if gap == 2:
+                out[i + 2] = ""
+    return [w for part in out for w in part.replace(",", " ,").split()]
+
+
+def _coordinate(word: str) -> bool:
+    return word in NUMBER_HOMOPHONES or _is_number(word.removeprefix("-"))
+
+
+def _digit(word: str) -> str:
+    return str(NUMBER_HOMOPHONES[word]) if word in NUMBER_HOMOPHONES else word

@@ -61,6 +61,27 @@ def test_a_robot_word_split_in_two_is_joined(said: str, read: str) -> None:
     assert heard(said, PROFILE) == read
 
 
+@pytest.mark.parametrize(("said", "read"), [
+    # A point's coordinates heard as homophones, with no comma between or with "and".
+    ("go to the point for too", "go to the point 4, 2"),
+    ("uh go to position for three", "go to position 4, 3"),
+    ("go to the coordinates three and for", "go to the coordinates 3, 4"),
+    ("go to x for y too", "go to x 4 y 2"),
+    # Tens heard as a word and "tee", and a hundred's count heard as a homophone.
+    ("turn left for tee five degrees", "turn left 0.7854 rad"),
+    ("turn left for tee for degrees", "turn left 0.7679 rad"),
+    ("turn left won hundred twenty degrees", "turn left 2.0944 rad"),
+])
+def test_a_number_heard_as_other_words_is_the_number(said: str, read: str) -> None:
+    assert heard(said, PROFILE) == read
+
+
+@pytest.mark.parametrize("said", ["go to the point to the left", "look for tee shirts", "drive twenty to the door",
+                                  "go to the point for the cup"])
+def test_a_homophone_that_is_no_number_stays_a_word(said: str) -> None:
+    assert heard(said, PROFILE) == normalize_task(said)
+
+
 @pytest.mark.parametrize("said", ["turn left", "look up a little", "pan a head left", "go back 2 metres",
                                   "look for words"])
 def test_words_that_are_words_on_their_own_stay_apart(said: str) -> None:
