@@ -152,6 +152,9 @@ _WHERE = tuple(tuple(w.split()) for w in ("in front of", "on top of", "next to",
 # Words that start a clause telling more of a thing before where it is ("the charger that's plugged in by
 # the desk").
 _RELATIVE = frozenset({"that", "which", "who"})
+# A thing's name ends where a clause tells where it is ("the remote is on the coffee table", "my keys are
+# right by the door", "the mug's on the desk").
+_TELLING_WHERE = _RELATIVE | {"is", "are", "s", "was", "were"}
 _PLACE_OPENERS = _OWNER | set(DETERMINERS)
 # A point's way followed by "of" says what the point lies from; only the start or the robot itself is read
 # ("1 m left of the start", "2 m in front of where you started"), not "1 m left of the table".
@@ -1026,15 +1029,19 @@ def things_at_places(task: str, plan: Plan) -> dict[int, str]:
 
 def at_things(plan: Plan, task: str) -> str:
     """The program of `plan` with each step on a place said only as where a thing is acting on the thing
-    instead; such a step after one on the thing already reached it, and is left out."""
+    instead; such a step after one on the thing already reached it, and one the plan also takes on the
+    thing is there already, so either is left out."""
     found = things_at_places(task, plan)
+    kept = [(c.skill, tuple(a.name.lower() for a in c.args if isinstance(a, ObjectRef)))
+            for i, c in enumerate(plan) if i not in found]
     lines = []
     for index, command in enumerate(plan):
         thing = found.get(index)
         if thing is None:
             lines.append(command.to_rsl())
             continue
-        if any(a.name.lower() == thing for c in plan.commands[:index] for a in c.args if isinstance(a, ObjectRef)):
+        if (command.skill, (thing,)) in kept or any(
+                a.name.lower() == thing for c in plan.commands[:index] for a in c.args if isinstance(a, ObjectRef)):
             continue
         args = tuple(ObjectRef(thing) if isinstance(a, ObjectRef) else a for a in command.args)
         lines.append(Command(command.skill, args, command.line, command.column).to_rsl())
@@ -1059,7 +1066,7 @@ def _thing_at(tokens: list[str], place: list[str]) -> str | None:
         if opened is None:
             return None
         span = before[opened + 1:]
-        span = span[:next((i for i, t in enumerate(span) if t in _RELATIVE), len(span))]
+        span = span[:next((i for i, t in enumerate(span) if t in _TELLING_WHERE), len(span))]
         if not 0 < len(span) <= 2 or any(w in FUNCTION_WORDS or w in NOT_NAMES or w.endswith(("ing", "ly"))
                                          for w in span):
             return None

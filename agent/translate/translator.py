@@ -286,7 +286,7 @@ class Translator:
                 refusal: Diagnostic | None = self._not_a_task(states[0], asked_nothing.reason)
             else:
                 if len(states) == 1 and assessment.doubts:
-                    other = (self._mended(states[0], plan, assessment, normalized, known)
+                    other = (self._mended(states[0].probabilities, plan, assessment, normalized, known)
                              or self._shorter_ending(states[0], normalized, known)
                              or self._other_choice(states[0], normalized, known, cancel, timings)
                              or self._clause_by_clause(normalized, plan, assessment, known, cancel, timings))
@@ -324,21 +324,21 @@ class Translator:
         progress.debug("putting the %s back: %r", back.part, steps.strip())
         return program + steps, whole.plan
 
-    def _mended(self, state: _ClauseState, plan: Plan, judged: Assessment, normalized: str,
+    def _mended(self, probabilities: tuple[float, ...], plan: Plan, judged: Assessment, normalized: str,
                 known: Collection[str] | None) -> _Candidate | None:
         """The first program a mend (agent/translate/mends.py) writes of a doubted plan that passes every
         check, judged on the first reading's own signal; None when none does."""
         for mend in MENDS:
-            passing = self._mend(mend, state, plan, judged, normalized, known)
+            passing = self._mend(mend, probabilities, plan, judged, normalized, known)
             if passing is not None:
                 return passing
         return None
 
-    def _mend(self, mend: Mend, state: _ClauseState, plan: Plan, judged: Assessment, normalized: str,
+    def _mend(self, mend: Mend, probabilities: tuple[float, ...], plan: Plan, judged: Assessment, normalized: str,
               known: Collection[str] | None) -> _Candidate | None:
         """What `mend` writes of `plan`, when its doubts name what it mends and the result passes every check."""
         written = mend.write(plan, judged.doubts, normalized, self.profile)
-        passing = None if written is None else self._passing(written, state.probabilities, normalized, known)
+        passing = None if written is None else self._passing(written, probabilities, normalized, known)
         if passing is not None:
             progress.debug("%s, it passes the checks", mend.what)
         return passing
@@ -474,7 +474,14 @@ class Translator:
         probabilities = tuple(p for s in states for p in s.probabilities)
         progress.debug("read a clause at a time: %s", " | ".join(f"{s.clause.text!r} -> {s.program.strip()!r}"
                                                                  for s in states))
-        return self._passing(_assemble(states), probabilities, normalized, known)
+        program = _assemble(states)
+        passing = self._passing(program, probabilities, normalized, known)
+        compiled = compile_program(program, self.profile, known) if passing is None else None
+        if compiled is None or compiled.plan is None or not compiled.ok or not len(compiled.plan):
+            return passing
+        # Read a clause at a time, the model reads a take-back or a place as words just as it does read whole.
+        judged = assess(normalized, compiled.plan, self.profile, model=model_signal(probabilities), known_objects=known)
+        return self._mended(probabilities, compiled.plan, judged, normalized, known)
 
     def _generate(self, prompt: str, automaton: RslAutomaton | None, cancel: CancelFlag | None,
                   timings: dict[str, float], fork: Fork | None = None) -> Generation:

@@ -186,13 +186,16 @@ def test_a_doubted_whole_reading_is_read_a_clause_at_a_time_and_questioned(adapt
 
 def test_a_take_back_read_alone_still_counts_against_the_clause_by_clause_reading(adapted: Translator) -> None:
     # "skip the turn" is a clause of its own: whatever it gives, the checks read it in the whole task, and
-    # the turn the first clause gives is still taken back.
+    # the turn the first clause gives is still taken back: the clause reading is mended as a whole one is,
+    # and the readings disagreed, so the person is asked.
     task = "turn left, then drive forward 2 metres, then skip the turn"
     normalized, plan, judged = _read_whole(adapted, task, "turnleft 1.5708;\nforward 2;\n")
     assert [d.check for d in judged.doubts] == ["cancelled"]
     timings = {"prompt": 0.0, "generate": 0.0}
-    assert adapted._clause_by_clause(normalized, plan, judged, None, None, timings) is None
-    assert timings["generate"] > 0
+    found = adapted._clause_by_clause(normalized, plan, judged, None, None, timings)
+    assert timings["generate"] > 0 and found is not None
+    program, _plan, _probabilities, assessment = found
+    assert program == "forward 2;\n" and assessment.unsure and [d.check for d in assessment.doubts] == ["whole"]
 
 
 def test_a_task_of_one_clause_is_not_read_again(adapted: Translator) -> None:
@@ -229,7 +232,7 @@ def _mended(mend: str, translator: Translator, task: str, program: str) -> Any:
     """What the mend named `mend` makes of `program` read whole, when that passes the checks."""
     normalized, plan, judged = _read_whole(translator, task, program)
     chosen = next(m for m in MENDS if m.name == mend)
-    return translator._mend(chosen, _whole_state(task, program), plan, judged, normalized, None)
+    return translator._mend(chosen, _whole_state(task, program).probabilities, plan, judged, normalized, None)
 
 
 def test_nothing_is_left_out_of_a_plan_no_take_back_doubts(translator: Translator) -> None:
@@ -260,6 +263,10 @@ def test_what_is_left_after_the_take_back_must_pass_the_checks_too(translator: T
      "approach newspaper;\ngrasp newspaper;\ngoto 0, 0;\n"),
     # A step on the place after one on the thing is left out: the thing was already reached.
     ("at the thing", "Pick up the banana next to the sink.", "grasp banana;\napproach sink;\n", "grasp banana;\n"),
+    # ... and so is one the plan also takes on the thing.
+    ("at the thing", "The remote is on the coffee table. Bring me the remote, would you?",
+     "approach coffee_table;\napproach remote;\ngrasp remote;\ngoto 0, 0;\n",
+     "approach remote;\ngrasp remote;\ngoto 0, 0;\n"),
     ("way as said", "Spin in a full circle, then grab the cup.", "turnright 6.2832;\ngrasp cup;\n",
      "turnleft 6.2832;\ngrasp cup;\n"),
     ("point as said", "Go to a point one metre to your right and two metres forward.", "goto 1, 2;\nforward 2;\n",
@@ -326,6 +333,16 @@ def test_a_clause_reading_of_words_read_whole_as_no_task_must_pass_the_checks(ad
     timings = {"prompt": 0.0, "generate": 0.0}
     assert adapted._no_task_read_in_clauses([state], normalized, None, None, timings) is None
     assert timings["generate"] > 0
+
+
+def test_a_clause_reading_is_mended_as_a_whole_reading_is(adapted: Translator) -> None:
+    # Read a clause at a time, the shipped adapter drives to the workbench the screwdriver is on first.
+    normalized, state = _refused_whole("The screwdriver is on the workbench. Fetch the screwdriver, then turn around.")
+    found = adapted._no_task_read_in_clauses([state], normalized, None, None, {"prompt": 0.0, "generate": 0.0})
+    assert found is not None
+    program, _plan, _probabilities, assessment = found
+    assert program == "approach screwdriver;\ngrasp screwdriver;\ngoto 0, 0;\nturnleft 3.1416;\n"
+    assert assessment.unsure and [d.check for d in assessment.doubts] == ["whole"]
 
 
 def test_a_whole_reading_that_gave_a_program_or_had_one_clause_is_not_read_again(adapted: Translator) -> None:

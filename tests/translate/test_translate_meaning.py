@@ -284,6 +284,10 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
      "the door only tells where to find the keys, but the plan acts on it (drive up to the door)"),
     ("bring me the charger that's plugged in by the desk", "approach desk; grasp desk; goto 0, 0;",
      "the desk only tells where to find the charger, but the plan acts on it (drive up to the desk)"),
+    # ... and where a clause of its own tells where the thing is.
+    ("the remote is on the coffee table. Bring me the remote, would you?",
+     "approach coffee_table; approach remote; grasp remote; goto 0, 0;",
+     "the coffee table only tells where to find the remote, but the plan acts on it (drive up to the coffee table)"),
 ])
 def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str, expected: str,
                                                          profile: Profile) -> None:
