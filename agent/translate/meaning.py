@@ -37,9 +37,11 @@ _STEP_AFTER = re.compile(r",?\s*(?:and\s+then|and|then)\s+[a-z]")
 # could head over"); the word itself is not consumed, so "and then head" finds "head" after "then".
 _CLAUSE_START = re.compile(r"(?:^|[,.;]|\b(?:and|then|so|but|or|you|to|can|could|would|will|should|must)\b)"
                            r"\s*(?=([a-z]+))")
+# A pause a speaker may take before correcting: "wait, no", "hang on, I meant".
+_HESITATIONS = "wait|hang on|hold on"
 # What a self-correction takes back: the number or the word right before its markers ("no, make that"),
-# when another follows. A hesitation before the markers ("wait, no", "hang on, I meant") is part of them.
-_CORRECTED = (rf"(?:,?\s+(?:wait|hang on|hold on))?(?:,?\s+(?:{'|'.join(MARKERS)}))+,?\s+"
+# when another follows. A hesitation before the markers is part of them.
+_CORRECTED = (rf"(?:,?\s+(?:{_HESITATIONS}))?(?:,?\s+(?:{'|'.join(MARKERS)}))+,?\s+"
               r"(?:(?:the|a|an) )?")
 # The number may be said again with its step ("1 m, no, back up 2 m"), in its unit or bare; a word of
 # sequence between makes the second another step.
@@ -54,7 +56,7 @@ _NEXT_WORD = re.compile(r"\s+([a-z]+)")
 _CORRECTION = re.compile(_CORRECTED)
 # A correction, or a pause alone, between a way and its opposite: "left, hang on, right", "back, I mean
 # forward", "left, scratch that, pan it right".
-_WAY_CORRECTION = re.compile(rf"(?:,?\s+(?:wait|hang on|hold on|{'|'.join(MARKERS)}))+,?\s+")
+_WAY_CORRECTION = re.compile(rf"(?:,?\s+(?:{_HESITATIONS}|{'|'.join(MARKERS)}))+,?\s+")
 # "would you mind turning left", "before grabbing the cup": the "-ing" word after "mind", "before" or
 # "after" asks for the act. Elsewhere an "-ing" form may tell what was done ("nice job turning left").
 _ASKED_DOING = re.compile(r"\b(mind|before|after) ([a-z]{3,}?)ing\b")
@@ -145,10 +147,10 @@ ASKS_NOTHING = frozenset({"framed", "narrated", "question", "called-off"})
 # A check whose steps nobody asked for: a step taken back, a thing corrected to another, the robot's own
 # part taken for a thing. Leaving those steps out may leave just what was asked.
 NOT_ASKED = frozenset({"cancelled", "corrected", "corrected-way", "own-part"})
-# Words that tell where a thing is ("the keys by the front door", "the towel from the floor"), longest first.
-_WHERE = tuple(tuple(w.split()) for w in ("in front of", "on top of", "next to", "close to", "by", "beside",
-                                           "near", "behind", "under", "underneath", "on", "from", "in", "inside",
-                                           "at", "off"))
+# Words that tell what a thing is near ("the keys by the front door", "the cup in front of your camera"), and
+# all that tell where a thing is ("the towel from the floor").
+_NEAR = ("in front of", "next to", "close to", "by", "beside", "near", "behind", "under", "at")
+_WHERE = tuple(tuple(w.split()) for w in (*_NEAR, "on top of", "underneath", "on", "from", "in", "inside", "off"))
 # Words that start a clause telling more of a thing before where it is ("the charger that's plugged in by
 # the desk").
 _RELATIVE = frozenset({"that", "which", "who"})
@@ -163,7 +165,7 @@ _OF_START = re.compile(r" of (?:the start|your start|the starting|where you|you\
 _COORDINATE_NAMED = re.compile(r"\b[xy]\b")
 # A noun said as the robot's own: "your gripper", "its camera"; and one said as where a thing is.
 _OWN_PART = re.compile(r"\b(?:your|its|the robot's) (?:own )?([a-z]+)")
-_PART_AS_PLACE = re.compile(r"\b(?:by|beside|near|next to|close to|in front of|behind|under|below|above|at) "
+_PART_AS_PLACE = re.compile(rf"\b(?:{'|'.join((*_NEAR, 'below', 'above'))}) "
                             r"(?:your|its|the robot's) (?:own )?(?:left |right )?([a-z]+)")
 _TOLERANCE = 0.02
 
