@@ -118,21 +118,19 @@ def _points(words: list[str]) -> list[str]:
     for i, word in enumerate(words):
         pair = words[i + 1:i + 4]
         if word == "x" and len(pair) == 3 and pair[1] == "y":
-            first, second = pair[0], pair[2]
+            second = 2
         elif word in _POINT_WORDS and len(pair) >= 2:
-            with_between = len(pair) == 3 and pair[1] in _BETWEEN_COORDINATES
-            first, second = pair[0], pair[2] if with_between else pair[1]
+            second = 2 if len(pair) == 3 and pair[1] in _BETWEEN_COORDINATES else 1
         else:
             continue
-        if not (_coordinate(first) and _coordinate(second) and {first, second} & NUMBER_HOMOPHONES.keys()):
+        said = (pair[0], pair[second])
+        if not (all(_coordinate(w) for w in said) and set(said) & NUMBER_HOMOPHONES.keys()):
             continue
-        gap = 1 if second is pair[1] and word != "x" else 2
-        out[i + 1] = _digit(first)
-        out[i + 1 + gap] = _digit(second)
+        out[i + 1], out[i + 1 + second] = (_digit(w) for w in said)
         if word != "x":
             # Said whole, a point is two numbers joined by a comma, as the normalizer writes "3 comma 2".
             out[i + 1] += ","
-            if gap == 2:
+            if second == 2:
                 out[i + 2] = ""
     return [w for part in out for w in part.replace(",", " ,").split()]
 

@@ -475,13 +475,14 @@ class Translator:
         progress.debug("read a clause at a time: %s", " | ".join(f"{s.clause.text!r} -> {s.program.strip()!r}"
                                                                  for s in states))
         program = _assemble(states)
-        passing = self._passing(program, probabilities, normalized, known)
-        compiled = compile_program(program, self.profile, known) if passing is None else None
-        if compiled is None or compiled.plan is None or not compiled.ok or not len(compiled.plan):
-            return passing
+        judged = self._judged(program, probabilities, normalized, known)
+        if judged is None:
+            return None
+        plan, assessment = judged
+        if not assessment.doubts:
+            return program, plan, probabilities, assessment
         # Read a clause at a time, the model reads a take-back or a place as words just as it does read whole.
-        judged = assess(normalized, compiled.plan, self.profile, model=model_signal(probabilities), known_objects=known)
-        return self._mended(probabilities, compiled.plan, judged, normalized, known)
+        return self._mended(probabilities, plan, assessment, normalized, known)
 
     def _generate(self, prompt: str, automaton: RslAutomaton | None, cancel: CancelFlag | None,
                   timings: dict[str, float], fork: Fork | None = None) -> Generation:
@@ -495,14 +496,20 @@ class Translator:
                  known: Collection[str] | None) -> _Candidate | None:
         """`program` with its plan and assessment, when it compiles to at least one step and no meaning
         check doubts it; the model's signal comes from `probabilities`."""
+        judged = self._judged(program, probabilities, normalized, known)
+        if judged is None or judged[1].doubts:
+            return None
+        return program, judged[0], probabilities, judged[1]
+
+    def _judged(self, program: str, probabilities: tuple[float, ...], normalized: str,
+                known: Collection[str] | None) -> tuple[Plan, Assessment] | None:
+        """`program`'s plan and the checks' assessment of it, when it compiles to at least one step; the
+        model's signal comes from `probabilities`."""
         compiled = compile_program(program, self.profile, known)
         if compiled.plan is None or not compiled.ok or not len(compiled.plan):
             return None
-        assessment = assess(normalized, compiled.plan, self.profile, model=model_signal(probabilities),
-                            known_objects=known)
-        if assessment.doubts:
-            return None
-        return program, compiled.plan, probabilities, assessment
+        return compiled.plan, assess(normalized, compiled.plan, self.profile, model=model_signal(probabilities),
+                                     known_objects=known)
 
     def prompt_for(self, text: str, extra: str = "") -> str:
         """The prompt for one normalized clause; `extra` is repair feedback."""
