@@ -768,21 +768,33 @@ def _where(step: Command) -> str:
     return "(" + ", ".join(quantity(a) for a in step.args if isinstance(a, Quantity)) + ")"
 
 
+def _grouped(check: str, found: Iterable[tuple[str, int]]) -> list[Doubt]:
+    """One doubt of `check` for each reason found, naming every step (from 0) found with it."""
+    steps: dict[str, list[int]] = {}
+    for reason, index in found:
+        steps.setdefault(reason, []).append(index)
+    return [Doubt(check, reason, tuple(indices)) for reason, indices in steps.items()]
+
+
+def _things(command: Command) -> list[str]:
+    """The names of the objects `command` acts on, in lower case."""
+    return [a.name.lower() for a in command.args if isinstance(a, ObjectRef)]
+
+
 def _cancelled(text: str, plan: Plan, vocab: Vocabulary, profile: Profile) -> list[Doubt]:
     """A step whose last mention takes it back ("..., actually skip the turn") is not in the plan."""
     spans = [(m.start(), m.end(), m.group(0).strip()) for m in _CANCELLED.finditer(text)]
     if not spans:
         return []
     mentions = [(m.start(), m.group(0)) for m in WORD.finditer(text)]
-    steps: dict[str, list[int]] = {}
+    found = []
     for index, command in enumerate(plan):
         words = vocab.step_words.get(command.skill, frozenset())
         last = next((at for at, token in reversed(mentions) if any(_inflected(token, w) for w in words)), None)
         span = next((said for start, end, said in spans if last is not None and start <= last < end), None)
         if span is not None:
-            reason = f'you said "{span}", but the plan still does it ({say(command, profile)})'
-            steps.setdefault(reason, []).append(index)
-    return [Doubt("cancelled", reason, tuple(indices)) for reason, indices in steps.items()]
+            found.append((f'you said "{span}", but the plan still does it ({say(command, profile)})', index))
+    return _grouped("cancelled", found)
 
 
 def _only(affirmed: str, plan: Plan, vocab: Vocabulary, named: list[ConventionReading], profile: Profile
@@ -985,9 +997,8 @@ def _corrected_objects(text: str, plan: Plan, profile: Profile) -> list[Doubt]:
     plan, unless it is said whole again after the correction. The plan must use the other thing too: a
     marker word may start other talk ("the cup, no hurry"), and a word of sequence after it adds a thing
     ("the cup, sorry, and the plate")."""
-    names = [(index, a.name.lower().split("_")) for index, c in enumerate(plan) for a in c.args
-             if isinstance(a, ObjectRef)]
-    steps: dict[str, list[int]] = {}
+    names = [(index, name.split("_")) for index, c in enumerate(plan) for name in _things(c)]
+    found = []
     for correction in _CORRECTION.finditer(text):
         before = WORD.findall(text[:correction.start()])
         rest = WORD.findall(text[correction.end():])
@@ -997,23 +1008,18 @@ def _corrected_objects(text: str, plan: Plan, profile: Profile) -> list[Doubt]:
         corrected_to = {"_".join(parts) for _, parts in names if set(parts) <= after}
         for index, parts in names:
             if before[-len(parts):] == parts and not set(parts) <= after and corrected_to - {"_".join(parts)}:
-                reason = (f"you took back the {' '.join(parts)}, but the plan still uses it "
-                          f"({say(plan.commands[index], profile)})")
-                steps.setdefault(reason, []).append(index)
-    return [Doubt("corrected", reason, tuple(indices)) for reason, indices in steps.items()]
+                found.append((f"you took back the {' '.join(parts)}, but the plan still uses it "
+                              f"({say(plan.commands[index], profile)})", index))
+    return _grouped("corrected", found)
 
 
 def _own_parts(text: str, plan: Plan, vocab: Vocabulary, profile: Profile) -> list[Doubt]:
     """A part of the robot said as its own ("the pen by your gripper") is where a thing is, never a thing
     to fetch or drive up to."""
     owned = {m.group(1) for m in _OWN_PART.finditer(text) if m.group(1) in vocab.noun_parts}
-    steps: dict[str, list[int]] = {}
-    for index, command in enumerate(plan):
-        for name in (a.name.lower() for a in command.args if isinstance(a, ObjectRef)):
-            if name in owned:
-                steps.setdefault(f"your {name} is part of the robot, not a thing to act on, but the plan "
-                                 f"does ({say(command, profile)})", []).append(index)
-    return [Doubt("own-part", reason, tuple(indices)) for reason, indices in steps.items()]
+    return _grouped("own-part", ((f"your {name} is part of the robot, not a thing to act on, but the plan does "
+                                  f"({say(command, profile)})", index)
+                                 for index, command in enumerate(plan) for name in _things(command) if name in owned))
 
 
 def things_at_places(task: str, plan: Plan) -> dict[int, str]:
@@ -1022,7 +1028,7 @@ def things_at_places(task: str, plan: Plan) -> dict[int, str]:
     tokens = WORD.findall(task)
     found: dict[int, str] = {}
     for index, command in enumerate(plan):
-        for name in (a.name.lower() for a in command.args if isinstance(a, ObjectRef)):
+        for name in _things(command):
             thing = _thing_at(tokens, name.split("_"))
             if thing is not None and thing != name:
                 found[index] = thing
@@ -1034,16 +1040,14 @@ def at_things(plan: Plan, task: str) -> str:
     instead; such a step after one on the thing already reached it, and one the plan also takes on the
     thing is there already, so either is left out."""
     found = things_at_places(task, plan)
-    kept = [(c.skill, tuple(a.name.lower() for a in c.args if isinstance(a, ObjectRef)))
-            for i, c in enumerate(plan) if i not in found]
+    kept = [(c.skill, tuple(_things(c))) for i, c in enumerate(plan) if i not in found]
     lines = []
     for index, command in enumerate(plan):
         thing = found.get(index)
         if thing is None:
             lines.append(command.to_rsl())
             continue
-        if (command.skill, (thing,)) in kept or any(
-                a.name.lower() == thing for c in plan.commands[:index] for a in c.args if isinstance(a, ObjectRef)):
+        if (command.skill, (thing,)) in kept or any(thing in _things(c) for c in plan.commands[:index]):
             continue
         args = tuple(ObjectRef(thing) if isinstance(a, ObjectRef) else a for a in command.args)
         lines.append(Command(command.skill, args, command.line, command.column).to_rsl())
@@ -1078,19 +1082,19 @@ def _thing_at(tokens: list[str], place: list[str]) -> str | None:
 
 def _places(text: str, plan: Plan, profile: Profile) -> list[Doubt]:
     """A place said only as where a thing is ("the keys by the front door") is not what the plan acts on."""
-    steps: dict[str, list[int]] = {}
+    found = []
     for index, thing in things_at_places(text, plan).items():
         command = plan.commands[index]
         place = next(a.name for a in command.args if isinstance(a, ObjectRef)).replace("_", " ")
-        steps.setdefault(f"the {place} only tells where to find the {thing.replace('_', ' ')}, but the plan "
-                         f"acts on it ({say(command, profile)})", []).append(index)
-    return [Doubt("place", reason, tuple(indices)) for reason, indices in steps.items()]
+        found.append((f"the {place} only tells where to find the {thing.replace('_', ' ')}, but the plan acts "
+                      f"on it ({say(command, profile)})", index))
+    return _grouped("place", found)
 
 
 def _corrected_ways(text: str, plan: Plan, vocab: Vocabulary, profile: Profile) -> list[Doubt]:
     """A way taken back for its opposite ("turn left, hang on, right"; "pan left, scratch that, pan it
     right") is not gone, unless it is said again after the correction."""
-    steps: dict[str, list[int]] = {}
+    found = []
     for m in _WAY_CORRECTION.finditer(text):
         before, after = WORD.findall(text[:m.start()]), WORD.findall(text[m.end():])
         said = before[-1] if before else ""
@@ -1101,8 +1105,6 @@ def _corrected_ways(text: str, plan: Plan, vocab: Vocabulary, profile: Profile) 
         if at + 1 < len(after) and after[at + 1] in _PLACE_OR_TIME:
             continue
         gone = {k for k in vocab.way_skills[said] if vocab.opposites.get(k) in vocab.way_skills[meant]}
-        for index, command in enumerate(plan):
-            if command.skill in gone:
-                steps.setdefault(f"you took back \"{said}\" for \"{meant}\", but the plan still goes {said} "
-                                 f"({say(command, profile)})", []).append(index)
-    return [Doubt("corrected-way", reason, tuple(indices)) for reason, indices in steps.items()]
+        found += [(f"you took back \"{said}\" for \"{meant}\", but the plan still goes {said} "
+                   f"({say(command, profile)})", index) for index, command in enumerate(plan) if command.skill in gone]
+    return _grouped("corrected-way", found)
