@@ -49,13 +49,14 @@ _DETERMINERS = frozenset({"the", "a", "an", "your", "my", "that", "this"})
 
 # Tens heard as a word and "tee" before a number's ones or "degrees" ("for tee five", "fif tee degrees"; not
 # "look for tee shirts"), and a hundred's count heard as a homophone ("won hundred").
-_TENS_HEARD = re.compile(r"\b(for|fore|fif|six|seven|ate|nine|thir|twen) tee (?=("
-                         + "|".join(w for w, v in ONES.items() if 0 < v < 10) + "|" + "|".join(NUMBER_HOMOPHONES)
-                         + r"|degrees?)\b)")
 _TENS = {"for": "forty", "fore": "forty", "fif": "fifty", "six": "sixty", "seven": "seventy", "ate": "eighty",
          "nine": "ninety", "thir": "thirty", "twen": "twenty"}
+_TENS_HEARD = re.compile(rf"\b({'|'.join(_TENS)}) tee (?=("
+                         + "|".join(w for w, v in ONES.items() if 0 < v < 10) + "|" + "|".join(NUMBER_HOMOPHONES)
+                         + r"|degrees?)\b)")
 _TENS_UNITS = r"(?:degrees?|centimet(?:er|re)s?|cm)"
-_HUNDREDS_HEARD = re.compile(r"\b(won|too|for|fore|tree|free|ate) (hundred|thousand)\b")
+# "to hundred" is left out: "turn to hundred degrees" may be "to" and a number.
+_HUNDREDS_HEARD = re.compile(rf"\b({'|'.join(h for h in NUMBER_HOMOPHONES if h != 'to')}) (hundred|thousand)\b")
 _COUNTS = {heard: next(word for word, value in ONES.items() if value == number)
            for heard, number in NUMBER_HOMOPHONES.items()}
 # Words that name a point right before its two coordinates ("the point for too"); "x" names the first of
