@@ -1041,17 +1041,17 @@ def at_things(plan: Plan, task: str) -> str:
     thing is there already, so either is left out."""
     found = things_at_places(task, plan)
     kept = [(c.skill, tuple(_things(c))) for i, c in enumerate(plan) if i not in found]
-    lines = []
+    commands = []
     for index, command in enumerate(plan):
         thing = found.get(index)
         if thing is None:
-            lines.append(command.to_rsl())
+            commands.append(command)
             continue
         if (command.skill, (thing,)) in kept or any(thing in _things(c) for c in plan.commands[:index]):
             continue
         args = tuple(ObjectRef(thing) if isinstance(a, ObjectRef) else a for a in command.args)
-        lines.append(Command(command.skill, args, command.line, command.column).to_rsl())
-    return "".join(line + "\n" for line in lines)
+        commands.append(Command(command.skill, args, command.line, command.column))
+    return Plan(tuple(commands), plan.profile).to_rsl()
 
 
 def _thing_at(tokens: list[str], place: list[str]) -> str | None:

@@ -31,8 +31,9 @@ class Mend:
     write: Callable[[Plan, tuple[Doubt, ...], str, Profile], str | None]
 
 
-def _program(commands: list[Command]) -> str:
-    return "".join(c.to_rsl() + "\n" for c in commands)
+def _program(plan: Plan, commands: list[Command]) -> str:
+    """The program of `commands`, in `plan`'s profile."""
+    return Plan(tuple(commands), plan.profile).to_rsl()
 
 
 def _left_out(plan: Plan, doubts: tuple[Doubt, ...], _task: str, _profile: Profile) -> str | None:
@@ -42,7 +43,7 @@ def _left_out(plan: Plan, doubts: tuple[Doubt, ...], _task: str, _profile: Profi
     dropped = {i for d in doubts if d.check in NOT_ASKED for i in d.steps}
     if not dropped:
         return None
-    return _program([c for i, c in enumerate(plan) if i not in dropped])
+    return _program(plan, [c for i, c in enumerate(plan) if i not in dropped])
 
 
 def _at_the_thing(plan: Plan, doubts: tuple[Doubt, ...], task: str, _profile: Profile) -> str | None:
@@ -60,8 +61,8 @@ def _way_as_said(plan: Plan, doubts: tuple[Doubt, ...], _task: str, profile: Pro
     if not turned:
         return None
     opposites = vocabulary(profile).opposites
-    return _program([Command(opposites[c.skill], c.args, c.line, c.column) if i in turned else c
-                     for i, c in enumerate(plan)])
+    return _program(plan, [Command(opposites[c.skill], c.args, c.line, c.column) if i in turned else c
+                           for i, c in enumerate(plan)])
 
 
 def _point_as_said(plan: Plan, doubts: tuple[Doubt, ...], task: str, profile: Profile) -> str | None:
@@ -73,7 +74,7 @@ def _point_as_said(plan: Plan, doubts: tuple[Doubt, ...], task: str, profile: Pr
     meant = at_point(plan.commands[steps[0]], point, profile) if steps and point else None
     if meant is None:
         return None
-    return _program([meant if i == steps[0] else c for i, c in enumerate(plan) if i not in steps[1:]])
+    return _program(plan, [meant if i == steps[0] else c for i, c in enumerate(plan) if i not in steps[1:]])
 
 
 def _done_again(plan: Plan, doubts: tuple[Doubt, ...], task: str, profile: Profile) -> str | None:
