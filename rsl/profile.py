@@ -244,6 +244,9 @@ class Profile:
     cannot: tuple[Inability, ...] = ()
     back: tuple[PartBack, ...] = ()
     frame: tuple[FrameWay, ...] = ()
+    # What people call this robot when they speak to it ("robot, look up"): any other name opening a task
+    # speaks to someone else.
+    called: tuple[str, ...] = ("robot",)
     source: str = field(repr=False, default="")
 
     def skill(self, keyword: str) -> Skill | None:
@@ -364,6 +367,10 @@ def _build(data: dict[str, Any], source: str) -> Profile:
     max_statements = read_settings(_Limits, data.get("limits", {}), error=ProfileError, source=source,
                                    prefix="limits.", docs="docs/skills.md").max_statements
 
+    called = robot.get("called", ["robot"])
+    if not isinstance(called, list) or not all(isinstance(w, str) and WORD.fullmatch(w) for w in called):
+        raise fail(f"[robot] called must be a list of lower-case words such as [\"robot\", \"robbie\"], "
+                   f"not {called!r}")
     return Profile(
         name=str(robot.get("name", Path(source).stem)),
         description=str(robot.get("description", "a robot")),
@@ -378,6 +385,7 @@ def _build(data: dict[str, Any], source: str) -> Profile:
         source=source,
         cannot=tuple(cannot),
         back=tuple(back),
+        called=tuple(called),
         frame=tuple(frame),
     )
 

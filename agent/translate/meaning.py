@@ -26,6 +26,7 @@ from agent.corrections import MARKERS
 from agent.translate.clauses import SHAPES
 from agent.translate.explain import quantity, say
 from agent.translate.names import DETERMINERS, FUNCTION_WORDS, NOT_NAMES
+from agent.translate.people import names_a_person
 from agent.translate.vocabulary import NUMBER_UNIT, WHOLE, WORD, ConventionReading, Vocabulary, vocabulary
 from rsl.plan import Command, ObjectRef, Plan, Quantity
 from rsl.profile import Profile
@@ -137,6 +138,9 @@ _DONE_BY_SPEAKER = re.compile(r"^(?:[a-z]+, )?(?:i|we) (?:just |already |then )?
 _DONE_BY_SOMEONE = re.compile(r"(?:^|, |\band |\bbut )(?:(?:yesterday|earlier|today|before|last [a-z]+"
                               r"|this [a-z]+|on [a-z]+day)?,? )?(?:the (?:other )?)?(?:you|it|he|she|they|robot)"
                               r" (?:just |already |then |also |once |never |always |[a-z]+ly )?([a-z]+ed)\b")
+# Whom a task is said to: one word and a comma at its start, after at most one greeting ("hey mia, look up"),
+# or a comma and one word at its end ("turn left at the lights, dad").
+_CALLED = re.compile(r"^(?:(?:hey|hi|hello|oi|ok|okay|yo),? )?([a-z]+), |, ([a-z]+)$")
 # Everything said so far called off at the end, with no step asked after it: "turn left, actually, never
 # mind", "go to the door and, actually, don't bother", "look up, no, cancel that".
 _CALLED_OFF = re.compile(r"\b(?:never ?mind|(?:forget|scrap|cancel|scratch|ignore) (?:about )?(?:it|that|this|all"
@@ -238,7 +242,23 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
         told = reported[0].group(0).strip(", ")
         doubts.append(Doubt("reported", f'you told what was done ("{told}"), not what the robot should do, and '
                                         f"the plan acts ({say(plan.commands[0], profile)})"))
+    doubts += _addressed(text, plan, vocab, profile)
     return tuple({d.reason: d for d in doubts}.values())
+
+
+def _addressed(text: str, plan: Plan, vocab: Vocabulary, profile: Profile) -> list[Doubt]:
+    """A task said to someone else by name ("Mia, look up, there's a balloon!") asks nothing of the robot.
+
+    Only a word that names a person is read so: a word the profile or the closed classes know, or one the
+    profile says the robot is called, opens a task to the robot ("robot, look up", "so, look up")."""
+    found = _CALLED.search(text)
+    if found is None:
+        return []
+    who = found.group(1) or found.group(2)
+    if who in profile.called or who in vocab.known_words or not names_a_person(who):
+        return []
+    return [Doubt("addressed", f'you spoke to "{who}", not to the robot, but the plan acts '
+                               f"({say(plan.commands[0], profile)})")]
 
 
 def _called_off(text: str, vocab: Vocabulary) -> str:

@@ -63,6 +63,16 @@ def test_broken_profiles_are_rejected_with_the_reason(patch, complaint):
         parse_profile(text.replace(original, patch, 1), source="broken.toml")
 
 
+def test_what_the_robot_is_called_comes_from_the_profile_and_leaves_the_digest(profile):
+    assert profile.called == ("robot",)
+    text = default_profile_path().read_text()
+    named = parse_profile(text.replace('called = ["robot"]', 'called = ["robot", "robbie"]'), source="named.toml")
+    assert named.called == ("robot", "robbie")
+    assert named.digest == profile.digest, "what the robot is called is how it is spoken to, not its language"
+    with pytest.raises(ProfileError, match=r"\[robot\] called must be a list of lower-case words"):
+        parse_profile(text.replace('called = ["robot"]', 'called = "Robbie"'), source="broken.toml")
+
+
 def test_missing_profile_file_is_a_clear_error(tmp_path):
     with pytest.raises(ProfileError, match="cannot read robot profile"):
         load_profile(tmp_path / "absent.toml")

@@ -288,6 +288,13 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
     ("the remote is on the coffee table. Bring me the remote, would you?",
      "approach coffee_table; approach remote; grasp remote; goto 0, 0;",
      "the coffee table only tells where to find the remote, but the plan acts on it (drive up to the coffee table)"),
+    # Said to someone else by name, at the start or the end, or to family.
+    ("Grandpa, turn right after the bridge", "turnright 1.5708;",
+     'you spoke to "grandpa", not to the robot, but the plan acts (turn right 90°)'),
+    ("Hey Lucy, look down at your shoes", "lookdown 0.5236;",
+     'you spoke to "lucy", not to the robot, but the plan acts (look down 30°)'),
+    ("Pass me the salt, Oliver.", "grasp salt;",
+     'you spoke to "oliver", not to the robot, but the plan acts (pick up the salt)'),
 ])
 def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str, expected: str,
                                                          profile: Profile) -> None:
@@ -408,7 +415,7 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     ("kindly proceed to the point four comma one", "goto 4, 1;"),
     ("I need you over at the point three, minus two", "goto 3, -2;"),
     # "would you mind" with an "-ing" form asks for the act.
-    ("hey robbie, would you mind backing up two metres?", "backward 2;"),
+    ("hey robot, would you mind backing up two metres?", "backward 2;"),
     ("mind scooting back a metre? cheers", "backward 1;"),
     ("would you mind heading over to the till?", "approach till;"),
     # So does "before" or "after" with one.
@@ -462,6 +469,10 @@ def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str,
     ("go to the table by the window and grab the cup", "approach table; grasp cup;"),
     ("grab the cup from the table, then go to the table", "grasp cup; approach table;"),
     ("pick up the cup on the table", "grasp cup;"),
+    # The robot called as the profile says, by a word anyone may be called, or a word that is no name.
+    ("robot, turn right", "turnright 1.5708;"),
+    ("buddy, turn right", "turnright 1.5708;"),
+    ("so, turn right", "turnright 1.5708;"),
 ])
 def test_a_plan_that_does_what_was_said_has_no_doubt(task: str, program: str, profile: Profile) -> None:
     assert reasons(task, program, profile, ["cup", "table", "keys"]) == []
@@ -476,6 +487,14 @@ def test_a_whole_command_verb_comes_from_the_profile(profile: Profile) -> None:
     task = normalize_task("face left")
     assert check_meaning(task, plan("turnleft 1.5708;", profile), profile) == ()
     assert [d.check for d in check_meaning(task, plan("turnleft 1.5708;", other), other)] == ["motion"]
+
+
+def test_a_robot_called_by_a_name_is_asked_nothing_when_called_so(profile: Profile) -> None:
+    text = Path(profile.source).read_text(encoding="utf-8")
+    named = parse_profile(text.replace('called = ["robot"]', 'called = ["robot", "lucy"]'))
+    task = normalize_task("Lucy, look down at your shoes")
+    assert [d.check for d in check_meaning(task, plan("lookdown 0.5236;", profile), profile)] == ["addressed"]
+    assert check_meaning(task, plan("lookdown 0.5236;", named), named) == ()
 
 
 def test_a_robot_described_otherwise_gets_its_own_parts(profile: Profile) -> None:
