@@ -161,6 +161,9 @@ class Convention:
     meaning: str
     task: str
     program: str
+    # Other words people say for the phrase ("slightly" for "a little"): read as the phrase before the model
+    # and the checks see a task, so they are how it is heard, not what an adapter learned.
+    also: tuple[str, ...] = ()
 
     @property
     def whole_command(self) -> bool:
@@ -341,9 +344,16 @@ def _build(data: dict[str, Any], source: str) -> Profile:
 
     conventions = tuple(
         Convention(phrase=str(c["phrase"]), meaning=str(c["meaning"]),
-                   task=str(c.get("task", "")), program=str(c.get("program", "")))
+                   task=str(c.get("task", "")), program=str(c.get("program", "")),
+                   also=_other_words(c, fail))
         for c in data.get("conventions", [])
     )
+    convention_phrases = {c.phrase for c in conventions}
+    for convention in conventions:
+        taken = next((w for w in convention.also if w in convention_phrases), None)
+        if taken is not None:
+            raise fail(f"[[conventions]] {convention.phrase!r}: `also` word {taken!r} is another convention's "
+                       "phrase")
     cannot = []
     for _index, what, phrases in _phrase_tables(data, "cannot", "what", "a sentence", fail):
         for phrase in phrases:
@@ -428,18 +438,29 @@ def _phrase_tables(data: dict[str, Any], table: str, key: str, shape: str,
 _LANGUAGE_KEYS = ("keyword", "description", "example", "aliases", "opposite", "params")
 
 
+def _other_words(table: dict[str, Any], fail: Callable[[str], ProfileError]) -> tuple[str, ...]:
+    """A convention's `also`: lower-case words or phrases, one space between words."""
+    also = table.get("also", [])
+    if not isinstance(also, list) or not all(isinstance(w, str) and re.fullmatch(r"[a-z]+(?: [a-z]+)*", w)
+                                             for w in also):
+        raise fail(f"[[conventions]] {table.get('phrase')!r}: `also` must be a list of lower-case words or "
+                   f"phrases such as [\"slightly\", \"a tad\"], not {also!r}")
+    return tuple(also)
+
+
 def _language_digest(data: dict[str, Any]) -> str:
     """The digest of the language a profile defines: what an adapter's card pins.
 
     It covers the robot's name, each skill's statement and meaning, the
-    conventions, the workspace and the statement limit: the things the prompt and the training
+    conventions (less the other words they are heard in), the workspace and the statement limit: the things
+    the prompt and the training
     data are made of. Rebinding a skill, rewording how it is explained or
     changing a joint limit keeps the adapter; renaming a skill does not.
     """
     language = {
         "robot": data.get("robot", {}).get("name"),
         "skills": [{key: skill.get(key) for key in _LANGUAGE_KEYS} for skill in data.get("skills", [])],
-        "conventions": data.get("conventions", []),
+        "conventions": [{k: v for k, v in c.items() if k != "also"} for c in data.get("conventions", [])],
         "workspace": data.get("workspace", {}),
         "limits": data.get("limits", {}),
     }

@@ -29,6 +29,7 @@ from __future__ import annotations
 import re
 
 from agent.normalize import NUMBER_HOMOPHONES, ONES, normalize_task
+from agent.translate.other_words import in_convention_words
 from agent.translate.vocabulary import Vocabulary, vocabulary
 from rsl.profile import Profile
 
@@ -41,8 +42,6 @@ _BEFORE_VERB = frozenset({"", "i", "you", "we", "they", "he", "she", "it", "can"
                           "should", "must", "to", "please", "and", "then"})
 # What cannot follow the verb "write": the end of a clause, or what a way is said of ("write side", "write turn").
 _CLAUSE_WORDS = frozenset({"", ",", "and", "then", "please", "now", "again", "instead", "side", "turn"})
-# Amounts said in words that the normalizer leaves as words ("turn write a little").
-_WORD_AMOUNTS = (("a", "little"), ("a", "bit"), ("slightly",))
 _HEARD_FOR_COLOUR = {"read": "red", "blew": "blue"}
 _DETERMINERS = frozenset({"the", "a", "an", "your", "my", "that", "this"})
 
@@ -66,7 +65,8 @@ _BETWEEN_COORDINATES = frozenset({",", "and", "comma"})
 
 
 def heard(task: str, profile: Profile) -> str:
-    """The task as the model and the checks read it: normalized, with mishearings read back."""
+    """The task as the model and the checks read it: normalized, with mishearings read back and a
+    convention's other words read as its phrase."""
     said = _TENS_HEARD.sub(lambda m: _TENS[m.group(1)] + " ", task.lower())
     # The ones after tens may be a homophone too ("for tee for degrees"); only before the units tens are
     # said in, so "twenty to the door" keeps its "to".
@@ -75,16 +75,18 @@ def heard(task: str, profile: Profile) -> str:
     said = _HUNDREDS_HEARD.sub(lambda m: f"{_COUNTS[m.group(1)]} {m.group(2)}", said)
     # The normalizer writes a clause comma right after its word ("turn write, then").
     words = _points(_joined(normalize_task(said).replace(",", " ,").split(), vocabulary(profile)))
+    # Amounts said in words, which the normalizer leaves as words ("turn write a little", "write a tad").
+    amounts = {tuple(p.split()) for c in profile.conventions if not c.whole_command for p in (c.phrase, *c.also)}
     out = []
     for i, word in enumerate(words):
-        before, after = words[i - 1] if i else "", words[i + 1:i + 3]
-        if word in _HEARD_FOR_RIGHT and _not_the_verb(before, after):
+        before, after = words[i - 1] if i else "", words[i + 1:i + 4]
+        if word in _HEARD_FOR_RIGHT and _not_the_verb(before, after, amounts):
             word = "right"
         elif (word in _HEARD_FOR_COLOUR and before in _DETERMINERS and after and after[0].isalpha()
               and after[0] not in _CLAUSE_WORDS):
             word = _HEARD_FOR_COLOUR[word]
         out.append(word)
-    return " ".join(out).replace(" ,", ",")
+    return in_convention_words(" ".join(out).replace(" ,", ","), profile)
 
 
 def _joined(words: list[str], vocab: Vocabulary) -> list[str]:
@@ -99,10 +101,10 @@ def _joined(words: list[str], vocab: Vocabulary) -> list[str]:
     return out
 
 
-def _not_the_verb(before: str, after: list[str]) -> bool:
+def _not_the_verb(before: str, after: list[str], amounts: set[tuple[str, ...]]) -> bool:
     if before in _BEFORE_NO_VERB:
         return True
-    amount = bool(after) and (_is_number(after[0]) or any(tuple(after[:len(w)]) == w for w in _WORD_AMOUNTS))
+    amount = bool(after) and (_is_number(after[0]) or any(tuple(after[:len(w)]) == w for w in amounts))
     if before in _BEFORE_VERB:
         return amount and not before
     return amount or (after[0] if after else "") in _CLAUSE_WORDS

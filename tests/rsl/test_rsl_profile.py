@@ -73,6 +73,20 @@ def test_what_the_robot_is_called_comes_from_the_profile_and_leaves_the_digest(p
         parse_profile(text.replace('called = ["robot"]', 'called = "Robbie"'), source="broken.toml")
 
 
+def test_other_words_for_a_convention_come_from_the_profile_and_leave_the_digest(profile):
+    little = next(c for c in profile.conventions if c.phrase == "a little")
+    assert "slightly" in little.also
+    text = default_profile_path().read_text()
+    without = parse_profile(re.sub(r"\nalso = \[[^\]]*\]", "", text), source="without.toml")
+    assert all(not c.also for c in without.conventions)
+    assert without.digest == profile.digest, "other words are how a phrase is heard, not what an adapter learned"
+    with pytest.raises(ProfileError, match="`also` must be a list of lower-case words"):
+        parse_profile(text.replace('also = ["a long way"', 'also = ["A long way"'), source="broken.toml")
+    with pytest.raises(ProfileError, match="`also` word 'a bit further' is another convention's phrase"):
+        parse_profile(text.replace('also = ["a long way"', 'also = ["a bit further", "a long way"'),
+                      source="broken.toml")
+
+
 def test_missing_profile_file_is_a_clear_error(tmp_path):
     with pytest.raises(ProfileError, match="cannot read robot profile"):
         load_profile(tmp_path / "absent.toml")
