@@ -243,7 +243,41 @@ def check_meaning(task: str, plan: Plan, profile: Profile, known_objects: Collec
         doubts.append(Doubt("reported", f'you told what was done ("{told}"), not what the robot should do, and '
                                         f"the plan acts ({say(plan.commands[0], profile)})"))
     doubts += _addressed(text, plan, vocab, profile)
+    doubts += _not_reached(text, plan, vocab, profile)
     return tuple({d.reason: d for d in doubts}.values())
+
+
+# What may come between a word of going and the step's word: "go over and pick up", "come back and grab".
+_GOING_BETWEEN = frozenset({"over", "on", "and", "back", "there", "then"})
+
+
+def _not_reached(text: str, plan: Plan, vocab: Vocabulary, profile: Profile) -> list[Doubt]:
+    """A thing the task says to go and act on ("go pick up the mug") is gone to first.
+
+    The skill the profile names to reach a thing out of reach (`out_of_reach`) is the going; a plan that
+    picks the thing up where the robot stands does not do it."""
+    tokens = WORD.findall(text)
+    found = []
+    for index, command in enumerate(plan):
+        reaching = vocab.reached_by.get(command.skill)
+        things = _things(command)
+        if reaching is None or not things:
+            continue
+        if any(c.skill == reaching and _things(c) == things for c in plan.commands[:index]):
+            continue
+        words = vocab.step_words.get(command.skill, frozenset())
+        for at, token in enumerate(tokens):
+            if not any(_inflected(token, w) for w in words):
+                continue
+            before = at - 1
+            while before >= 0 and at - before <= 3 and tokens[before] in _GOING_BETWEEN:
+                before -= 1
+            if before >= 0 and tokens[before] in vocab.going_words:
+                said = " ".join(tokens[before:at + 1])
+                found.append((f'you said "{said}", but the plan does not go to the {things[0].replace("_", " ")} '
+                              f"first ({say(command, profile)})", index))
+                break
+    return _grouped("reach", found)
 
 
 def _addressed(text: str, plan: Plan, vocab: Vocabulary, profile: Profile) -> list[Doubt]:

@@ -46,6 +46,21 @@ def _left_out(plan: Plan, doubts: tuple[Doubt, ...], _task: str, _profile: Profi
     return _program(plan, [c for i, c in enumerate(plan) if i not in dropped])
 
 
+def _reached_first(plan: Plan, doubts: tuple[Doubt, ...], _task: str, profile: Profile) -> str | None:
+    """The step that reaches a thing (the profile's `out_of_reach`) put before the step the task said to go
+    and do: "go pick up the mug" often comes out as `grasp mug;` alone."""
+    steps = {i for d in doubts if d.check == "reach" for i in d.steps}
+    if not steps:
+        return None
+    reached_by = vocabulary(profile).reached_by
+    commands: list[Command] = []
+    for i, c in enumerate(plan):
+        if i in steps:
+            commands.append(Command(reached_by[c.skill], c.args[:1], c.line, c.column))
+        commands.append(c)
+    return _program(plan, commands)
+
+
 def _at_the_thing(plan: Plan, doubts: tuple[Doubt, ...], task: str, _profile: Profile) -> str | None:
     """Acting on the thing where the plan acted on the place said only as where it is: "head over to the
     keys by the front door" often comes out as `approach door;`, the last thing said."""
@@ -91,4 +106,6 @@ MENDS = (
     Mend("way as said", "the plan went the other way than the task's convention; turned", _way_as_said),
     Mend("point as said", "the plan drove elsewhere than the point said from the start; set to it", _point_as_said),
     Mend("done again", "the task asked for its steps again and the plan did them once; repeated", _done_again),
+    Mend("reached first", "the task said to go to a thing and the plan acted on it where it stood; gone to first",
+         _reached_first),
 )

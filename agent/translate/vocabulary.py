@@ -57,6 +57,10 @@ class Vocabulary:
     # profile's [[frame]]; and each way's phrase -> (axis, sign).
     point_offset: re.Pattern[str]
     frame: dict[str, tuple[str, int]]
+    # skill keyword -> the skill that brings the robot to the thing first (`out_of_reach`: grasp -> approach)
+    reached_by: dict[str, str]
+    # Words of going to a place: the words of those skills and of the base's distance skills, less ways.
+    going_words: frozenset[str]
 
 
 @dataclass(frozen=True)
@@ -197,6 +201,12 @@ def _build_vocabulary(profile: Profile) -> Vocabulary:
         gone = [k for k in reading.skills if k in opposites and opposites[k] not in reading.skills]
         if len(gone) == 1 and not set(WORD.findall(convention.task)) & way_skills.keys():
             unsaid_ways.append(UnsaidWay(opposites[gone[0]], gone[0], reading.amounts, convention.task))
+    reached_by = {s.keyword: s.out_of_reach for s in profile.skills if s.out_of_reach}
+    distance_skills = [s for s in profile.skills if parts.get(s.keyword, WHOLE) == WHOLE
+                       and s.keyword not in coordinates and any(p.unit == "m" for p in s.params)]
+    going_words = frozenset(w for s in profile.skills if s.keyword in reached_by.values() or s in distance_skills
+                            for w in (*step_words[s.keyword], *s.aliases)
+                            if w.isalpha() and w not in direction_words)
     frame = {phrase: (way.axis, way.sign) for way in profile.frame for phrase in way.phrases}
     # The longest phrase first, so "to your right" is read whole rather than as "right" alone.
     frame_phrases = "|".join(re.escape(p) for p in sorted(frame, key=len, reverse=True)) or "(?!)"
@@ -215,7 +225,7 @@ def _build_vocabulary(profile: Profile) -> Vocabulary:
                        command_verbs={w: frozenset(ps) for w, ps in command_verbs.items()},
                        unsaid_ways=tuple(unsaid_ways), past_forms=_past_forms(skill_word_set),
                        point_offset=re.compile(rf"(?<![\w.])(\d*\.?\d+) m ({frame_phrases})\b"),
-                       frame=frame)
+                       frame=frame, reached_by=reached_by, going_words=going_words)
 
 
 def _past_forms(words: frozenset[str]) -> frozenset[str]:

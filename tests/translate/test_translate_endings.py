@@ -273,6 +273,8 @@ def test_what_is_left_after_the_take_back_must_pass_the_checks_too(translator: T
      "goto 2, -1;\n"),
     ("done again", "Rotate left 30 degrees and move forward 2 meters, and repeat that once more.",
      "turnleft 0.5236;\nforward 2;\n", "turnleft 0.5236;\nforward 2;\nturnleft 0.5236;\nforward 2;\n"),
+    ("reached first", "Look up, then go over and grab the umbrella.", "lookup 0.5236;\ngrasp umbrella;\n",
+     "lookup 0.5236;\napproach umbrella;\ngrasp umbrella;\n"),
 ])
 def test_a_mend_writes_what_its_doubt_names_and_judges_it_on_the_model(
         translator: Translator, mend: str, task: str, program: str, mended: str) -> None:
@@ -290,6 +292,9 @@ def test_a_mend_writes_what_its_doubt_names_and_judges_it_on_the_model(
     ("point as said", "go to x 1, y 2", "goto 2, 1;\n"),
     # "again" inside a step asks for that step, not for everything before it once more.
     ("done again", "go forward 2 metres, then turn left again", "forward 2;\nturnleft 1.5708;\n"),
+    # Gone to already, or not said to go: "drive forward and pick up" drives no way to the thing.
+    ("reached first", "go to the table and pick up the fork", "approach table;\napproach fork;\ngrasp fork;\n"),
+    ("reached first", "drive forward two metres and pick up the box", "forward 2;\ngrasp box;\n"),
 ])
 def test_a_mend_keeps_a_plan_its_doubt_does_not_name(translator: Translator, mend: str, task: str,
                                                      program: str) -> None:

@@ -295,6 +295,9 @@ def test_parts_come_from_the_descriptions(profile: Profile) -> None:
      'you spoke to "lucy", not to the robot, but the plan acts (look down 30°)'),
     ("Pass me the salt, Oliver.", "grasp salt;",
      'you spoke to "oliver", not to the robot, but the plan acts (pick up the salt)'),
+    # A thing said to go and pick up, picked up where the robot stands.
+    ("come over and pick up the umbrella", "grasp umbrella;",
+     'you said "come over and pick", but the plan does not go to the umbrella first (pick up the umbrella)'),
 ])
 def test_a_plan_that_is_not_what_was_said_gets_a_reason(task: str, program: str, expected: str,
                                                          profile: Profile) -> None:
