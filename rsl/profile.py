@@ -452,10 +452,10 @@ def _language_digest(data: dict[str, Any]) -> str:
     """The digest of the language a profile defines: what an adapter's card pins.
 
     It covers the robot's name, each skill's statement and meaning, the
-    conventions (less the other words they are heard in), the workspace and the statement limit: the things
-    the prompt and the training
-    data are made of. Rebinding a skill, rewording how it is explained or
-    changing a joint limit keeps the adapter; renaming a skill does not.
+    conventions (less the other words they are heard in), the workspace and
+    the statement limit: the things the prompt and the training data are
+    made of. Rebinding a skill, rewording how it is explained or changing a
+    joint limit keeps the adapter; renaming a skill does not.
     """
     language = {
         "robot": data.get("robot", {}).get("name"),
