@@ -52,6 +52,11 @@ class Command:
             raise TypeError(f"argument {index} of `{self.skill}` is a number, not an object")
         return arg.name
 
+    def reached_by(self, skill: str) -> Command:
+        """The step of `skill` (this step's skill's `out_of_reach`) that brings the robot to this step's thing
+        first: it takes the thing and stands where this step was written."""
+        return Command(skill, self.args[:1], self.line, self.column)
+
     def to_rsl(self) -> str:
         """The one canonical spelling: `kw a, b;`."""
         if not self.args:

@@ -99,7 +99,7 @@ def check_world(plan: Plan, profile: Profile, robot: Any) -> WorldCheck:
         if tracking and skill.out_of_reach and command.args and isinstance(command.args[0], ObjectRef):
             target = by_name.get(command.args[0].name)
             if target is not None and math.hypot(target.x - x, target.y - y) > profile.motion.reach:
-                first = Command(skill.out_of_reach, (command.args[0],), command.line, command.column)
+                first = command.reached_by(skill.out_of_reach)
                 commands.append(first)
                 added.append(first.to_rsl())
                 tracking = False

@@ -56,7 +56,7 @@ def _reached_first(plan: Plan, doubts: tuple[Doubt, ...], _task: str, profile: P
     commands: list[Command] = []
     for i, c in enumerate(plan):
         if i in steps:
-            commands.append(Command(reached_by[c.skill], c.args[:1], c.line, c.column))
+            commands.append(c.reached_by(reached_by[c.skill]))
         commands.append(c)
     return _program(plan, commands)
 

@@ -74,13 +74,12 @@ def heard(task: str, profile: Profile) -> str:
                   lambda m: f"{m.group(1)} {_COUNTS[m.group(2)]}", said)
     said = _HUNDREDS_HEARD.sub(lambda m: f"{_COUNTS[m.group(1)]} {m.group(2)}", said)
     # The normalizer writes a clause comma right after its word ("turn write, then").
-    words = _points(_joined(normalize_task(said).replace(",", " ,").split(), vocabulary(profile)))
-    # Amounts said in words, which the normalizer leaves as words ("turn write a little", "write a tad").
-    amounts = {tuple(p.split()) for c in profile.conventions if not c.whole_command for p in (c.phrase, *c.also)}
+    vocab = vocabulary(profile)
+    words = _points(_joined(normalize_task(said).replace(",", " ,").split(), vocab))
     out = []
     for i, word in enumerate(words):
         before, after = words[i - 1] if i else "", words[i + 1:i + 4]
-        if word in _HEARD_FOR_RIGHT and _not_the_verb(before, after, amounts):
+        if word in _HEARD_FOR_RIGHT and _not_the_verb(before, after, vocab.word_amounts):
             word = "right"
         elif (word in _HEARD_FOR_COLOUR and before in _DETERMINERS and after and after[0].isalpha()
               and after[0] not in _CLAUSE_WORDS):
@@ -101,7 +100,8 @@ def _joined(words: list[str], vocab: Vocabulary) -> list[str]:
     return out
 
 
-def _not_the_verb(before: str, after: list[str], amounts: set[tuple[str, ...]]) -> bool:
+def _not_the_verb(before: str, after: list[str], amounts: frozenset[tuple[str, ...]]) -> bool:
+    # Before an amount said in words ("write a little", "write a tad") only the way can be meant.
     if before in _BEFORE_NO_VERB:
         return True
     amount = bool(after) and (_is_number(after[0]) or any(tuple(after[:len(w)]) == w for w in amounts))

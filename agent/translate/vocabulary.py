@@ -61,6 +61,9 @@ class Vocabulary:
     reached_by: dict[str, str]
     # Words of going to a place: the words of those skills and of the base's distance skills, less ways.
     going_words: frozenset[str]
+    # Amounts said in words, which the normalizer leaves as words: each amount convention's phrase and other
+    # words, split ("a", "little"), ("slightly",).
+    word_amounts: frozenset[tuple[str, ...]]
 
 
 @dataclass(frozen=True)
@@ -225,7 +228,9 @@ def _build_vocabulary(profile: Profile) -> Vocabulary:
                        command_verbs={w: frozenset(ps) for w, ps in command_verbs.items()},
                        unsaid_ways=tuple(unsaid_ways), past_forms=_past_forms(skill_word_set),
                        point_offset=re.compile(rf"(?<![\w.])(\d*\.?\d+) m ({frame_phrases})\b"),
-                       frame=frame, reached_by=reached_by, going_words=going_words)
+                       frame=frame, reached_by=reached_by, going_words=going_words,
+                       word_amounts=frozenset(tuple(p.split()) for c in profile.conventions if not c.whole_command
+                                              for p in (c.phrase, *c.also)))
 
 
 def _past_forms(words: frozenset[str]) -> frozenset[str]:
